@@ -1,0 +1,27 @@
+//! # squeal-core
+//!
+//! The physics and numerics of squeal, a toolkit for friction-induced
+//! vibration (disc-brake squeal first of all). It is the clean specification
+//! of `MODEL.md` made executable:
+//!
+//! - [`friction`]: friction laws μ(v) (thesis, Coulomb, Stribeck, rational);
+//! - [`model`]: the disc–pad model of the thesis and the mass on a belt, as
+//!   plug-ins (a vector field per contact mode, guards, transition rules);
+//! - [`integrate`]: an event-driven DOP853 integrator that locates every
+//!   stick, slip, reversal, separation and contact on the dense output;
+//! - [`sink`]: where a run's samples and events go;
+//! - [`initial`]: initial states (`rest`, `equilibrium`, offsets).
+//!
+//! The crate is pure computation: no files, no threads, no clocks.
+
+pub mod friction;
+pub mod initial;
+pub mod integrate;
+pub mod model;
+pub mod params;
+pub mod sink;
+
+pub use friction::FrictionLaw;
+pub use integrate::{simulate, Flow, IntegrateError, RunInfo, Sink, Solver, SolverOptions, Stats};
+pub use model::{belt::Belt, disc_pad::DiscPad, EventKind, Mode, Model, ModelError, Parameters};
+pub use params::{ParamError, ParamSpec};

@@ -1,0 +1,70 @@
+//! Colormaps written as a few control points with linear interpolation in sRGB.
+
+/// Approximation of matplotlib's perceptually uniform "viridis" (11 samples).
+const VIRIDIS: [[u8; 3]; 11] = [
+    [0x44, 0x01, 0x54],
+    [0x48, 0x24, 0x75],
+    [0x41, 0x44, 0x87],
+    [0x35, 0x5F, 0x8D],
+    [0x2A, 0x78, 0x8E],
+    [0x21, 0x91, 0x8C],
+    [0x22, 0xA8, 0x84],
+    [0x44, 0xBF, 0x70],
+    [0x7A, 0xD1, 0x51],
+    [0xBD, 0xDF, 0x26],
+    [0xFD, 0xE7, 0x25],
+];
+
+/// ColorBrewer "RdBu" reversed: blue (negative, stable) – white (0) – red (positive).
+const RDBU_R: [[u8; 3]; 7] = [
+    [0x21, 0x66, 0xAC],
+    [0x67, 0xA9, 0xCF],
+    [0xD1, 0xE5, 0xF0],
+    [0xF7, 0xF7, 0xF7],
+    [0xFD, 0xDB, 0xC7],
+    [0xEF, 0x8A, 0x62],
+    [0xB2, 0x18, 0x2B],
+];
+
+fn interpolate(points: &[[u8; 3]], t: f64) -> [u8; 3] {
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    let n = points.len() - 1;
+    let pos = t * n as f64;
+    let i = (pos.floor() as usize).min(n - 1);
+    let f = pos - i as f64;
+    let (a, b) = (points[i], points[i + 1]);
+    let mut out = [0u8; 3];
+    for c in 0..3 {
+        out[c] = (a[c] as f64 + f * (b[c] as f64 - a[c] as f64)).round() as u8;
+    }
+    out
+}
+
+/// Sequential map, `t` in `[0, 1]` (clamped).
+pub(crate) fn sequential(t: f64) -> [u8; 3] {
+    interpolate(&VIRIDIS, t)
+}
+
+/// Diverging map, `t` in `[0, 1]` (clamped) with white at 0.5.
+pub(crate) fn diverging(t: f64) -> [u8; 3] {
+    interpolate(&RDBU_R, t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn endpoints_and_centre() {
+        assert_eq!(sequential(0.0), VIRIDIS[0]);
+        assert_eq!(sequential(1.0), VIRIDIS[10]);
+        assert_eq!(sequential(7.0), VIRIDIS[10]);
+        assert_eq!(diverging(0.5), [0xF7, 0xF7, 0xF7]);
+        assert_eq!(diverging(-1.0), RDBU_R[0]);
+        let _ = sequential(f64::NAN);
+    }
+}
