@@ -1,1 +1,63 @@
-fn main() {}
+//! `squeal`: simulate, analyse and listen to friction-induced vibration.
+//!
+//! A thin layer over `squeal-core` (physics, integration), `squeal-signal`
+//! (spectra, audio) and `squeal-plot` (pictures). Exit codes: 0 success,
+//! 1 a run failed (numerical trouble, I/O), 2 bad input.
+
+mod commands;
+mod model;
+mod output;
+mod run;
+mod scenario;
+
+use clap::{Args, Parser, Subcommand};
+use run::RunError;
+use std::process::ExitCode;
+
+/// squeal: disc-brake squeal and friction-induced vibration, simulated exactly.
+#[derive(Parser, Debug)]
+#[command(name = "squeal", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// The scenario and its overrides, shared by every command that runs a model.
+#[derive(Args, Debug, Clone)]
+pub struct ScenarioArgs {
+    /// A built-in scenario name (disc-pad, belt-coulomb, belt) or a TOML file.
+    #[arg(default_value = "disc-pad")]
+    pub scenario: String,
+    /// Override a parameter or setting: --set N=2000 --set friction=coulomb (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub sets: Vec<String>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Integrate a scenario and write series.csv, events.csv and summary.json.
+    Simulate(commands::simulate::SimulateArgs),
+    /// Built-in scenarios: list them, or print one as a documented TOML file.
+    Scenario {
+        #[command(subcommand)]
+        what: commands::scenario::ScenarioCmd,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Simulate(a) => commands::simulate::run(a),
+        Command::Scenario { what } => commands::scenario::run(what),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            match e {
+                RunError::Input(_) => ExitCode::from(2),
+                _ => ExitCode::from(1),
+            }
+        }
+    }
+}

@@ -1,0 +1,39 @@
+//! `squeal scenario list | show NAME`.
+
+use crate::run::RunError;
+use crate::scenario::{InputError, Scenario, BUILTINS};
+use clap::Subcommand;
+
+/// What to do with scenarios.
+#[derive(Subcommand, Debug)]
+pub enum ScenarioCmd {
+    /// List the built-in scenarios.
+    List,
+    /// Print a built-in scenario as a documented TOML file.
+    Show {
+        /// Built-in scenario name.
+        name: String,
+    },
+}
+
+/// Run the command.
+pub fn run(cmd: ScenarioCmd) -> Result<(), RunError> {
+    match cmd {
+        ScenarioCmd::List => {
+            for name in BUILTINS {
+                let s = Scenario::builtin(name).expect("listed built-ins exist");
+                println!("{name:<14} {}", s.description);
+            }
+        }
+        ScenarioCmd::Show { name } => {
+            let s = Scenario::builtin(&name).ok_or_else(|| {
+                InputError(format!(
+                    "scenario '{name}': no built-in of that name (built-ins: {})",
+                    BUILTINS.join(", ")
+                ))
+            })?;
+            print!("{}", s.to_toml());
+        }
+    }
+    Ok(())
+}

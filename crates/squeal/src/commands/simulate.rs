@@ -1,0 +1,128 @@
+//! `squeal simulate [SCENARIO] [--set NAME=VALUE]... [--duration S] [--out DIR]`.
+
+use crate::output;
+use crate::run::{self, RunError, Staging};
+use crate::scenario::{InputError, Scenario, Setting};
+use crate::ScenarioArgs;
+use clap::Args;
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `squeal simulate`.
+#[derive(Args, Debug)]
+pub struct SimulateArgs {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
+    /// Simulated time in seconds (overrides the scenario's).
+    #[arg(long)]
+    duration: Option<f64>,
+    /// Output folder (default: out/<scenario name>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Series formats, comma-separated: csv, npy.
+    #[arg(long, default_value = "csv", value_delimiter = ',')]
+    format: Vec<String>,
+    /// Print summary.json on stdout instead of the human summary.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Resolve the scenario named on the command line, with its overrides.
+pub fn resolve(args: &ScenarioArgs) -> Result<Scenario, InputError> {
+    let mut sc = Scenario::load(&args.scenario)?;
+    sc.apply_overrides(&args.sets)?;
+    Ok(sc)
+}
+
+/// Run the command.
+pub fn run(a: SimulateArgs) -> Result<(), RunError> {
+    let mut sc = resolve(&a.scenario)?;
+    if let Some(d) = a.duration {
+        sc.apply("duration", &Setting::Number(d))
+            .map_err(|e| InputError(format!("--duration: {}", e.0)))?;
+        sc.validate()?;
+    }
+    let (mut csv, mut npy) = (false, false);
+    for f in &a.format {
+        match f.as_str() {
+            "csv" => csv = true,
+            "npy" => npy = true,
+            other => {
+                return Err(InputError(format!("--format {other}: expected csv or npy")).into())
+            }
+        }
+    }
+    let dest = a
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
+    let run = run::run(&sc)?;
+    let t0 = Instant::now();
+    let stage = Staging::new(&dest)?;
+    if csv {
+        output::write_series_csv(&run, &stage.path("series.csv"))?;
+    }
+    if npy {
+        output::write_series_npy(&run, &stage.path("series.npy"))?;
+    }
+    output::write_events_csv(&run, &stage.path("events.csv"))?;
+    let velocity_names: Vec<String> = {
+        let names = sc.model.state_names();
+        names[names.len() / 2..]
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    };
+    let mut summary = output::integrator_json(&run);
+    summary["scenario"] = sc.to_json();
+    summary["columns"] = json!(run.columns);
+    summary["rms"] = json!(output::tail_rms(&run, &velocity_names));
+    let output_s = t0.elapsed().as_secs_f64();
+    summary["timing"] = json!({ "integrate_s": run.integrate_s, "output_s": output_s });
+    output::write_json(&summary, &stage.path("summary.json"))?;
+    let dest = stage.commit()?;
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&summary).map_err(|e| RunError::Io(e.to_string()))?
+        );
+    } else {
+        print_human(&sc, &run, &summary, &dest);
+    }
+    Ok(())
+}
+
+fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest: &std::path::Path) {
+    let s = &run.info.stats;
+    println!(
+        "{} ({}): {} s simulated in {:.2} s — {} steps ({} rejected), {} RHS evaluations",
+        sc.name,
+        sc.model.name(),
+        sc.duration,
+        run.integrate_s,
+        s.accepted,
+        s.rejected,
+        s.rhs_evals
+    );
+    let ev: Vec<String> = squeal_core::EventKind::ALL
+        .iter()
+        .map(|k| format!("{} {}", s.event_count(*k), k.as_str()))
+        .collect();
+    println!(
+        "events: {}; stick fraction {:.3e}",
+        ev.join(", "),
+        s.stick_fraction()
+    );
+    if let Some(rms) = summary["rms"].as_object() {
+        let parts: Vec<String> = rms
+            .iter()
+            .map(|(k, v)| format!("{k} {:.3e}", v.as_f64().unwrap_or(0.0)))
+            .collect();
+        println!(
+            "RMS velocity over the last 20 % (m/s): {}",
+            parts.join(", ")
+        );
+    }
+    println!("output: {}", dest.display());
+}

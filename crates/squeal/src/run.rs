@@ -1,0 +1,248 @@
+//! Running a scenario: integrate, collect columns, and stage outputs in a
+//! temporary folder that is renamed into place only when complete.
+
+use crate::model::AnyModel;
+use crate::scenario::{InputError, Scenario};
+use crate::with_model;
+use indicatif::{ProgressBar, ProgressStyle};
+use squeal_core::initial::initial_state;
+use squeal_core::integrate::{Flow, Sink};
+use squeal_core::{simulate, EventKind, Mode, Model, RunInfo};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Why a run failed: bad input (exit code 2) or trouble during the run (exit code 1).
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// Bad input, detected before anything was written.
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// Numerical failure (step underflow, chatter, …) with its time and cause.
+    #[error("simulation failed: {0}")]
+    Numerical(String),
+    /// Writing output failed.
+    #[error("{0}")]
+    Io(String),
+}
+
+/// A finished run: uniformly sampled columns and the event list.
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// Column names: `t`, the states, then the model's derived columns.
+    pub columns: Vec<String>,
+    /// Column data, same order as `columns`.
+    pub data: Vec<Vec<f64>>,
+    /// Events `(t, kind)` in order.
+    pub events: Vec<(f64, EventKind)>,
+    /// Integrator statistics and end time.
+    pub info: RunInfo,
+    /// Wall time of the integration (s).
+    pub integrate_s: f64,
+    /// Output sample rate (Hz).
+    pub sample_rate: f64,
+}
+
+impl Run {
+    /// The column called `name`.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.columns
+            .iter()
+            .position(|c| c == name)
+            .map(|i| self.data[i].as_slice())
+    }
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.data.first().map_or(0, Vec::len)
+    }
+    /// Whether the run has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+struct Collect<'a, M> {
+    model: &'a M,
+    any: &'a AnyModel,
+    data: Vec<Vec<f64>>,
+    derived: Vec<f64>,
+    events: Vec<(f64, EventKind)>,
+    progress: &'a ProgressBar,
+    t_end: f64,
+    next_tick: f64,
+}
+
+impl<M: Model<N>, const N: usize> Sink<N> for Collect<'_, M> {
+    fn sample(&mut self, t: f64, z: &[f64; N], mode: Mode) -> Flow {
+        self.data[0].push(t);
+        for i in 0..N {
+            self.data[1 + i].push(z[i]);
+        }
+        let obs = self.model.observe(t, mode, z);
+        self.any.derived_values(&obs, mode, &mut self.derived);
+        for (j, v) in self.derived.iter().enumerate() {
+            self.data[1 + N + j].push(*v);
+        }
+        if t >= self.next_tick {
+            self.progress.set_position((1000.0 * t / self.t_end) as u64);
+            self.next_tick = t + self.t_end / 200.0;
+        }
+        Flow::Continue
+    }
+    fn event(&mut self, t: f64, kind: EventKind, _z: &[f64; N], _mode: Mode) {
+        self.events.push((t, kind));
+    }
+}
+
+/// A progress bar on a terminal, nothing otherwise.
+pub fn progress_bar(len: u64, what: &str) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::new(len);
+    pb.set_style(
+        ProgressStyle::with_template(
+            "{msg} [{bar:40}] {percent:>3}% {elapsed_precise} (eta {eta})",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> "),
+    );
+    pb.set_message(what.to_string());
+    pb
+}
+
+fn run_model<M: Model<N>, const N: usize>(
+    model: &M,
+    any: &AnyModel,
+    sc: &Scenario,
+    progress: &ProgressBar,
+) -> Result<Run, RunError> {
+    let mut offsets = [0.0; N];
+    offsets.copy_from_slice(&sc.offsets);
+    let z0 = initial_state(model, sc.initial, &offsets).map_err(|e| {
+        RunError::Input(InputError(format!(
+            "initial = {}: {e}",
+            sc.initial.as_str()
+        )))
+    })?;
+    let mut columns = vec!["t".to_string()];
+    columns.extend(model.state_names().iter().map(|s| s.to_string()));
+    columns.extend(any.derived_columns().iter().map(|s| s.to_string()));
+    let expected = (sc.duration * sc.sample_rate) as usize + 2;
+    let mut sink = Collect {
+        model,
+        any,
+        data: (0..columns.len())
+            .map(|_| Vec::with_capacity(expected))
+            .collect(),
+        derived: Vec::with_capacity(8),
+        events: Vec::new(),
+        progress,
+        t_end: sc.duration,
+        next_tick: 0.0,
+    };
+    let start = Instant::now();
+    let info = simulate(
+        model,
+        0.0,
+        z0,
+        sc.duration,
+        sc.sample_rate,
+        sc.solver,
+        &mut sink,
+    )
+    .map_err(|e| RunError::Numerical(e.to_string()))?;
+    let integrate_s = start.elapsed().as_secs_f64();
+    progress.finish_and_clear();
+    Ok(Run {
+        columns,
+        data: sink.data,
+        events: sink.events,
+        info,
+        integrate_s,
+        sample_rate: sc.sample_rate,
+    })
+}
+
+/// Integrate a scenario, with a progress bar on a terminal.
+pub fn run(sc: &Scenario) -> Result<Run, RunError> {
+    let pb = progress_bar(1000, &format!("simulating {}", sc.name));
+    with_model!(&sc.model, m => run_model(m, &sc.model, sc, &pb))
+}
+
+/// Integrate a scenario quietly (for sweeps).
+pub fn run_quiet(sc: &Scenario) -> Result<Run, RunError> {
+    let pb = ProgressBar::hidden();
+    with_model!(&sc.model, m => run_model(m, &sc.model, sc, &pb))
+}
+
+/// An output folder written under a temporary name and renamed into place
+/// by [`Staging::commit`]; dropped uncommitted, it is removed.
+pub struct Staging {
+    tmp: PathBuf,
+    dest: PathBuf,
+    done: bool,
+}
+
+impl Staging {
+    /// Stage output for `dest`.
+    pub fn new(dest: &Path) -> Result<Staging, RunError> {
+        let io = |e: std::io::Error, p: &Path| {
+            RunError::Io(format!("cannot create {}: {e}", p.display()))
+        };
+        let parent = dest
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        std::fs::create_dir_all(parent).map_err(|e| io(e, parent))?;
+        let name = dest
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "out".into());
+        let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        if tmp.exists() {
+            let _ = std::fs::remove_dir_all(&tmp);
+        }
+        std::fs::create_dir_all(&tmp).map_err(|e| io(e, &tmp))?;
+        Ok(Staging {
+            tmp,
+            dest: dest.to_path_buf(),
+            done: false,
+        })
+    }
+    /// Path of a file inside the staging folder.
+    pub fn path(&self, file: &str) -> PathBuf {
+        self.tmp.join(file)
+    }
+    /// The staging folder.
+    pub fn dir(&self) -> &Path {
+        &self.tmp
+    }
+    /// Move the complete output into place (replacing an older one).
+    pub fn commit(mut self) -> Result<PathBuf, RunError> {
+        let io = |e: std::io::Error| {
+            RunError::Io(format!(
+                "cannot move output into {}: {e}",
+                self.dest.display()
+            ))
+        };
+        if self.dest.exists() {
+            let old = self.tmp.with_extension("old");
+            std::fs::rename(&self.dest, &old).map_err(io)?;
+            std::fs::rename(&self.tmp, &self.dest).map_err(io)?;
+            let _ = std::fs::remove_dir_all(&old);
+        } else {
+            std::fs::rename(&self.tmp, &self.dest).map_err(io)?;
+        }
+        self.done = true;
+        Ok(self.dest.clone())
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        if !self.done {
+            let _ = std::fs::remove_dir_all(&self.tmp);
+        }
+    }
+}
