@@ -128,7 +128,14 @@ impl Scenario {
     /// Parse a scenario from TOML text (see `squeal scenario show`).
     pub fn from_toml(text: &str) -> Result<Scenario, InputError> {
         let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
-            InputError(format!("malformed TOML: {}", e.message().trim()))
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+            let msg = e.message().trim().replace('\n', "; ");
+            match line {
+                Some(l) => InputError(format!("malformed TOML at line {l}: {msg}")),
+                None => InputError(format!("malformed TOML: {msg}")),
+            }
         })?;
         let model_name = match table.get("model") {
             Some(toml::Value::String(s)) => s.clone(),

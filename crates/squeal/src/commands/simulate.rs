@@ -15,7 +15,7 @@ pub struct SimulateArgs {
     #[command(flatten)]
     scenario: ScenarioArgs,
     /// Simulated time in seconds (overrides the scenario's).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     duration: Option<f64>,
     /// Output folder (default: out/<scenario name>).
     #[arg(long)]
