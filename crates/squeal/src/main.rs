@@ -4,6 +4,7 @@
 //! (spectra, audio) and `squeal-plot` (pictures). Exit codes: 0 success,
 //! 1 a run failed (numerical trouble, I/O), 2 bad input.
 
+mod analysis;
 mod commands;
 mod model;
 mod output;
@@ -37,6 +38,10 @@ pub struct ScenarioArgs {
 enum Command {
     /// Integrate a scenario and write series.csv, events.csv and summary.json.
     Simulate(commands::simulate::SimulateArgs),
+    /// Redraw the pictures of a saved run without re-simulating.
+    Plot(commands::plot::PlotArgs),
+    /// Render a velocity as a WAV file (from a saved run or a scenario).
+    Listen(commands::listen::ListenArgs),
     /// Built-in scenarios: list them, or print one as a documented TOML file.
     Scenario {
         #[command(subcommand)]
@@ -49,6 +54,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Simulate(a) => commands::simulate::run(a),
         Command::Scenario { what } => commands::scenario::run(what),
+        Command::Plot(a) => commands::plot::run(a),
+        Command::Listen(a) => commands::listen::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -85,12 +85,40 @@ impl AnyModel {
     pub fn validate(&self) -> Result<(), ParamError> {
         with_model!(self, m => m.validate())
     }
-    /// Index of the velocity channel shown as "tangential" in pictures and
-    /// metrics (the disc's, or the mass's).
-    pub fn tangential_velocity(&self) -> &'static str {
-        match self {
-            AnyModel::DiscPad(_) => "vx_d",
-            AnyModel::Belt(_) => "v",
-        }
+    /// The signals shown and analysed for this model.
+    pub fn channels(&self) -> Channels {
+        channels_for(self.name())
+    }
+}
+
+/// Which columns the pictures and metrics use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Channels {
+    /// Tangential velocity (the disc's, or the mass's).
+    pub tangential: &'static str,
+    /// Normal velocity, if the model has one.
+    pub normal: Option<&'static str>,
+    /// Displacement and velocity of the phase portrait (the pad's tangential motion).
+    pub phase: (&'static str, &'static str),
+}
+
+/// Channels by model name (also used for runs read back from disk).
+pub fn channels_for(model: &str) -> Channels {
+    match model {
+        "belt" => Channels {
+            tangential: "v",
+            normal: None,
+            phase: ("x", "v"),
+        },
+        "hoffmann" => Channels {
+            tangential: "vx",
+            normal: Some("vy"),
+            phase: ("x", "vx"),
+        },
+        _ => Channels {
+            tangential: "vx_d",
+            normal: Some("vy_d"),
+            phase: ("x_p", "vx_p"),
+        },
     }
 }

@@ -126,3 +126,119 @@ pub fn write_json(value: &Value, path: &Path) -> Result<(), RunError> {
     text.push('\n');
     std::fs::write(path, text).map_err(|e| io_err(path, e))
 }
+
+/// Read a run folder written by `squeal simulate` back: its columns (from
+/// `series.csv`, or `series.npy` with the names from `summary.json`) and
+/// its summary.
+pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
+    let bad = |msg: String| RunError::Input(crate::scenario::InputError(msg));
+    if !dir.is_dir() {
+        return Err(bad(format!("run folder {}: not a folder", dir.display())));
+    }
+    let summary_path = dir.join("summary.json");
+    let summary: Value = std::fs::read_to_string(&summary_path)
+        .map_err(|e| bad(format!("{}: cannot read: {e}", summary_path.display())))
+        .and_then(|t| {
+            serde_json::from_str(&t)
+                .map_err(|e| bad(format!("{}: malformed JSON: {e}", summary_path.display())))
+        })?;
+    let csv = dir.join("series.csv");
+    let npy = dir.join("series.npy");
+    let (columns, data) = if csv.is_file() {
+        let text = std::fs::read_to_string(&csv)
+            .map_err(|e| bad(format!("{}: cannot read: {e}", csv.display())))?;
+        let mut lines = text.lines();
+        let header: Vec<String> = lines
+            .next()
+            .unwrap_or("")
+            .split(',')
+            .map(|s| s.trim().to_string())
+            .collect();
+        let mut data = vec![Vec::new(); header.len()];
+        for (i, line) in lines.enumerate() {
+            let mut n = 0;
+            for (c, cell) in line.split(',').enumerate() {
+                let v: f64 = cell.trim().parse().map_err(|_| {
+                    bad(format!(
+                        "{}: line {}: '{cell}' is not a number",
+                        csv.display(),
+                        i + 2
+                    ))
+                })?;
+                if c < data.len() {
+                    data[c].push(v);
+                }
+                n += 1;
+            }
+            if n != header.len() {
+                return Err(bad(format!(
+                    "{}: line {}: {n} cells, header has {}",
+                    csv.display(),
+                    i + 2,
+                    header.len()
+                )));
+            }
+        }
+        (header, data)
+    } else if npy.is_file() {
+        let bytes =
+            std::fs::read(&npy).map_err(|e| bad(format!("{}: cannot read: {e}", npy.display())))?;
+        let columns: Vec<String> = summary["columns"]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .filter_map(|v| v.as_str().map(String::from))
+                    .collect()
+            })
+            .unwrap_or_default();
+        if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" || columns.is_empty() {
+            return Err(bad(format!("{}: not a squeal .npy file", npy.display())));
+        }
+        let hlen = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+        let body = &bytes[(10 + hlen).min(bytes.len())..];
+        let ncol = columns.len();
+        let rows = body.len() / 8 / ncol;
+        let mut data = vec![Vec::with_capacity(rows); ncol];
+        for (k, chunk) in body.chunks_exact(8).enumerate() {
+            data[k % ncol].push(f64::from_le_bytes(chunk.try_into().expect("8 bytes")));
+        }
+        (columns, data)
+    } else {
+        return Err(bad(format!(
+            "run folder {}: no series.csv or series.npy",
+            dir.display()
+        )));
+    };
+    let sample_rate = summary["scenario"]["sample_rate"].as_f64().unwrap_or(0.0);
+    if !(sample_rate > 0.0) {
+        return Err(bad(format!(
+            "{}: no scenario.sample_rate",
+            summary_path.display()
+        )));
+    }
+    let mut events = Vec::new();
+    if let Ok(text) = std::fs::read_to_string(dir.join("events.csv")) {
+        for line in text.lines().skip(1) {
+            if let Some((t, k)) = line.split_once(',') {
+                let kind = EventKind::ALL.into_iter().find(|e| e.as_str() == k.trim());
+                if let (Ok(t), Some(kind)) = (t.parse::<f64>(), kind) {
+                    events.push((t, kind));
+                }
+            }
+        }
+    }
+    let t_final = data.first().and_then(|t| t.last().copied()).unwrap_or(0.0);
+    let run = Run {
+        columns,
+        data,
+        events,
+        info: squeal_core::RunInfo {
+            stats: Default::default(),
+            t_final,
+            stopped_early: false,
+        },
+        integrate_s: 0.0,
+        sample_rate,
+    };
+    Ok((run, summary))
+}

@@ -1,9 +1,9 @@
 //! `squeal simulate [SCENARIO] [--set NAME=VALUE]... [--duration S] [--out DIR]`.
 
-use crate::output;
 use crate::run::{self, RunError, Staging};
 use crate::scenario::{InputError, Scenario, Setting};
 use crate::ScenarioArgs;
+use crate::{analysis, output};
 use clap::Args;
 use serde_json::json;
 use std::path::PathBuf;
@@ -26,6 +26,12 @@ pub struct SimulateArgs {
     /// Print summary.json on stdout instead of the human summary.
     #[arg(long)]
     json: bool,
+    /// Also write the tangential disc velocity as sound (squeal.wav, 48 kHz).
+    #[arg(long)]
+    wav: bool,
+    /// Skip the pictures (triplet, spectrogram, phase portrait).
+    #[arg(long)]
+    no_plots: bool,
 }
 
 /// Resolve the scenario named on the command line, with its overrides.
@@ -78,6 +84,25 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
     summary["scenario"] = sc.to_json();
     summary["columns"] = json!(run.columns);
     summary["rms"] = json!(output::tail_rms(&run, &velocity_names));
+    let channels = sc.model.channels();
+    let an = analysis::analyse(&run, &channels);
+    summary["spectrum"] = an.spectrum_json();
+    summary["growth_rate"] = an.growth_json();
+    summary["verdict"] = json!(an.verdict.as_str());
+    if !a.no_plots {
+        analysis::draw(&run, &an, &channels, &sc.name, stage.dir())?;
+    }
+    if a.wav {
+        if let Some(x) = run.column(channels.tangential) {
+            let clip = analysis::write_wav(x, run.sample_rate, &stage.path("squeal.wav"), false)?;
+            if clip.looped {
+                eprintln!(
+                    "note: the run ({:.3} s) is shorter than the 2 s of sound: its last steady part is looped",
+                    clip.source_seconds
+                );
+            }
+        }
+    }
     let output_s = t0.elapsed().as_secs_f64();
     summary["timing"] = json!({ "integrate_s": run.integrate_s, "output_s": output_s });
     output::write_json(&summary, &stage.path("summary.json"))?;
@@ -124,5 +149,13 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
             parts.join(", ")
         );
     }
+    if let Some(t) = summary["spectrum"]["tangential"]["dominant_hz"].as_f64() {
+        let n = summary["spectrum"]["normal"]["dominant_hz"].as_f64();
+        match n {
+            Some(n) => println!("dominant frequencies: tangential {t:.1} Hz, normal {n:.1} Hz"),
+            None => println!("dominant frequency: {t:.1} Hz"),
+        }
+    }
+    println!("verdict: {}", summary["verdict"].as_str().unwrap_or("?"));
     println!("output: {}", dest.display());
 }

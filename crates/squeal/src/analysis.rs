@@ -1,0 +1,341 @@
+//! What a run means: spectra of the tangential and normal velocities (as the
+//! thesis's spectral analyser showed them), growth rate, and a one-word
+//! verdict; and the pictures and sound made from them.
+
+use crate::model::Channels;
+use crate::run::{Run, RunError};
+use serde_json::{json, Map, Value};
+use squeal_core::EventKind;
+use squeal_plot::{Format, HeatmapSpec, Labels, Panel, Series};
+use squeal_signal::{
+    find_peaks, growth_rate_linear_part, spectrogram, welch, GrowthOptions, Peak, PeakOptions,
+    Spectrum, Verdict, VerdictOptions, WelchOptions,
+};
+use std::path::Path;
+
+/// Longest Welch segment (samples): 16384 at 200 kHz resolves 12.2 Hz.
+pub const SEGMENT: usize = 16384;
+
+/// The spectrum of one signal with its strongest peaks.
+#[derive(Debug, Clone)]
+pub struct ChannelSpectrum {
+    /// Column name.
+    pub signal: String,
+    /// One-sided Welch PSD, (m/s)²/Hz.
+    pub spectrum: Spectrum,
+    /// Strongest peaks, strongest first.
+    pub peaks: Vec<Peak>,
+}
+
+/// Spectra, growth and verdict of a run.
+#[derive(Debug, Clone)]
+pub struct Analysis {
+    /// Tangential velocity spectrum.
+    pub tangential: Option<ChannelSpectrum>,
+    /// Normal velocity spectrum.
+    pub normal: Option<ChannelSpectrum>,
+    /// Growth rate of each velocity over its exponential part: (signal, rate 1/s, t0, t1, R²).
+    pub growth: Vec<(String, f64, f64, f64, f64)>,
+    /// One word: decays, grows, limit-cycle, stick-slip.
+    pub verdict: Verdict,
+    /// Whether stick or reversal events occur in the last quarter of the run.
+    pub stick_slip_in_tail: bool,
+}
+
+fn spectrum_of(name: &str, x: &[f64], fs: f64) -> Option<ChannelSpectrum> {
+    if x.len() < 16 {
+        return None;
+    }
+    let opts = WelchOptions {
+        seg_len: Some(SEGMENT.min(x.len())),
+        ..WelchOptions::default()
+    };
+    let spectrum = welch(x, fs, &opts).ok()?;
+    // Peaks within 60 dB of the strongest: below that lies the numerical noise floor.
+    let peaks = find_peaks(
+        &spectrum,
+        5,
+        &PeakOptions {
+            max_below_strongest_db: 60.0,
+            ..PeakOptions::default()
+        },
+    );
+    Some(ChannelSpectrum {
+        signal: name.to_string(),
+        spectrum,
+        peaks,
+    })
+}
+
+/// Analyse a run. Velocities are the columns whose names start with `v`.
+pub fn analyse(run: &Run, ch: &Channels) -> Analysis {
+    let fs = run.sample_rate;
+    let tangential = run
+        .column(ch.tangential)
+        .and_then(|x| spectrum_of(ch.tangential, x, fs));
+    let normal = ch
+        .normal
+        .and_then(|n| run.column(n).and_then(|x| spectrum_of(n, x, fs)));
+    let t_end = run
+        .column("t")
+        .and_then(|t| t.last().copied())
+        .unwrap_or(0.0);
+    let tail_start = 0.75 * t_end;
+    let stick_slip_in_tail = run
+        .events
+        .iter()
+        .any(|(t, k)| *t >= tail_start && matches!(k, EventKind::Stick | EventKind::Reverse));
+    let stick_flag = if stick_slip_in_tail { 1.0 } else { 0.0 };
+    let mut growth = Vec::new();
+    let mut verdicts = Vec::new();
+    for (name, col) in run.columns.iter().zip(&run.data) {
+        if !name.starts_with('v') || name == "v_rel" {
+            continue;
+        }
+        if let Ok(g) = growth_rate_linear_part(col, fs, &GrowthOptions::default()) {
+            if g.fit.rate.is_finite() {
+                growth.push((
+                    name.clone(),
+                    g.fit.rate,
+                    g.fit.t_start,
+                    g.fit.t_end,
+                    g.fit.r_squared,
+                ));
+            }
+        }
+        if let Ok(c) = squeal_signal::classify_with(col, fs, stick_flag, &VerdictOptions::default())
+        {
+            verdicts.push(c.verdict);
+        }
+    }
+    // The system's verdict: growing anywhere beats a steady oscillation, which beats decay.
+    let verdict = if verdicts.contains(&Verdict::Grows) {
+        Verdict::Grows
+    } else if verdicts.contains(&Verdict::StickSlip) {
+        Verdict::StickSlip
+    } else if verdicts.contains(&Verdict::LimitCycle) {
+        if stick_slip_in_tail {
+            Verdict::StickSlip
+        } else {
+            Verdict::LimitCycle
+        }
+    } else {
+        Verdict::Decays
+    };
+    Analysis {
+        tangential,
+        normal,
+        growth,
+        verdict,
+        stick_slip_in_tail,
+    }
+}
+
+fn channel_json(c: &Option<ChannelSpectrum>) -> Value {
+    match c {
+        None => Value::Null,
+        Some(c) => {
+            let peaks: Vec<Value> = c
+                .peaks
+                .iter()
+                .map(|p| json!({ "freq_hz": p.freq, "level_db": p.level_db }))
+                .collect();
+            json!({
+                "signal": c.signal,
+                "dominant_hz": c.peaks.first().map(|p| p.freq),
+                "peaks": peaks,
+            })
+        }
+    }
+}
+
+impl Analysis {
+    /// The `spectrum` key of summary.json.
+    pub fn spectrum_json(&self) -> Value {
+        let df = self.tangential.as_ref().map(|c| c.spectrum.df);
+        json!({
+            "window": "hann",
+            "segment": self.tangential.as_ref().map(|c| (c.spectrum.freq.len() - 1) * 2),
+            "resolution_hz": df,
+            "tangential": channel_json(&self.tangential),
+            "normal": channel_json(&self.normal),
+        })
+    }
+    /// The `growth_rate` key of summary.json: per velocity, rate (1/s) and window (s).
+    pub fn growth_json(&self) -> Value {
+        let mut m = Map::new();
+        for (name, rate, t0, t1, r2) in &self.growth {
+            m.insert(
+                name.clone(),
+                json!({ "rate": rate, "t_start": t0, "t_end": t1, "r_squared": r2 }),
+            );
+        }
+        Value::Object(m)
+    }
+}
+
+/// Write the pictures of a run into `dir`: `triplet` (the thesis's three
+/// pictures), `spectrogram` and `phase` (pad tangential phase portrait), as
+/// PNG and SVG.
+pub fn draw(
+    run: &Run,
+    an: &Analysis,
+    ch: &Channels,
+    title: &str,
+    dir: &Path,
+) -> Result<(), RunError> {
+    let plot_err = |e: squeal_plot::PlotError| RunError::Io(format!("drawing failed: {e}"));
+    let formats = [Format::Png, Format::Svg];
+    let t = run.column("t").unwrap_or(&[]);
+    // The thesis's pictures: each velocity against time on its own axis (their
+    // sizes differ by orders of magnitude), then the spectrum of each.
+    let tan_title = format!("{title}: tangential velocity {}", ch.tangential);
+    let nor_title = format!("{title}: normal velocity {}", ch.normal.unwrap_or(""));
+    let mut panels = Vec::new();
+    if let Some(x) = run.column(ch.tangential) {
+        panels.push(
+            Panel::new(&tan_title, "time (s)", "velocity (m/s)").with_series(Series::new(
+                ch.tangential,
+                t,
+                x,
+            )),
+        );
+    }
+    if let Some((n, x)) = ch.normal.and_then(|n| run.column(n).map(|x| (n, x))) {
+        panels.push(
+            Panel::new(&nor_title, "time (s)", "velocity (m/s)").with_series(Series::new(n, t, x)),
+        );
+    }
+    let chans: Vec<(&ChannelSpectrum, &str)> =
+        [(&an.tangential, "tangential"), (&an.normal, "normal")]
+            .into_iter()
+            .filter_map(|(c, w)| c.as_ref().map(|c| (c, w)))
+            .collect();
+    let db: Vec<Vec<f64>> = chans.iter().map(|(c, _)| c.spectrum.to_db()).collect();
+    let titles: Vec<String> = chans
+        .iter()
+        .map(|(c, w)| format!("power spectral density of {} ({w})", c.signal))
+        .collect();
+    let labels: Vec<Vec<String>> = chans
+        .iter()
+        .map(|(c, _)| {
+            c.peaks
+                .iter()
+                .take(2)
+                .map(|p| format!("{:.1} Hz", p.freq))
+                .collect()
+        })
+        .collect();
+    for (k, (c, _)) in chans.iter().enumerate() {
+        let mut p = Panel::new(&titles[k], "frequency (Hz)", "PSD (dB re 1 (m/s)²/Hz)")
+            .with_series(Series::new(&c.signal, &c.spectrum.freq, &db[k]));
+        for (peak, label) in c.peaks.iter().zip(&labels[k]) {
+            p = p.with_peak(peak.freq, label);
+        }
+        panels.push(p);
+    }
+    let size = (1200, 300 * panels.len() as u32);
+    squeal_plot::line_panels(dir.join("triplet"), &formats, size, &panels).map_err(plot_err)?;
+
+    if let Some(x) = run.column(ch.tangential) {
+        let seg = 2048.min(x.len().max(2));
+        if let Ok(sg) = spectrogram(
+            x,
+            run.sample_rate,
+            seg,
+            (seg / 4).max(1),
+            squeal_signal::window::Window::Hann,
+        ) {
+            let title = format!("{title}: spectrogram of {}", ch.tangential);
+            let values = transpose(&sg.psd_db, sg.n_times(), sg.n_freqs());
+            let spec = HeatmapSpec {
+                value_range: Some((sg.max_db() - 100.0, sg.max_db())),
+                ..HeatmapSpec::new(
+                    &title,
+                    "time (s)",
+                    "frequency (Hz)",
+                    "PSD (dB re 1 (m/s)²/Hz)",
+                    &sg.times,
+                    &sg.freqs,
+                    &values,
+                )
+            };
+            squeal_plot::heatmap(
+                dir.join("spectrogram"),
+                &formats,
+                squeal_plot::SIZE_SINGLE,
+                &spec,
+            )
+            .map_err(plot_err)?;
+        }
+    }
+    if let (Some(x), Some(v)) = (run.column(ch.phase.0), run.column(ch.phase.1)) {
+        // The last fifth of the run: the settled motion (a stick line, if any, is flat at v = V).
+        let from = x.len() - x.len() / 5;
+        let (x, v) = (&x[from..], &v[from..]);
+        let t_from = t.get(from).copied().unwrap_or(0.0);
+        let title = format!("{title}: pad tangential phase portrait, t ≥ {t_from:.3} s");
+        let x_label = format!("{} (m)", ch.phase.0);
+        let y_label = format!("{} (m/s)", ch.phase.1);
+        let labels = Labels {
+            title: &title,
+            x_label: &x_label,
+            y_label: &y_label,
+        };
+        squeal_plot::phase_portrait(
+            dir.join("phase"),
+            &formats,
+            squeal_plot::SIZE_SINGLE,
+            x,
+            v,
+            &labels,
+        )
+        .map_err(plot_err)?;
+    }
+    Ok(())
+}
+
+/// Row-major [time][freq] → row-major [freq][time] (heatmap rows are y).
+fn transpose(a: &[f64], n_rows: usize, n_cols: usize) -> Vec<f64> {
+    let mut out = vec![0.0; a.len()];
+    for r in 0..n_rows {
+        for c in 0..n_cols {
+            out[c * n_rows + r] = a[r * n_cols + c];
+        }
+    }
+    out
+}
+
+/// Render a velocity column as a WAV file (16-bit PCM or 32-bit float, 48 kHz).
+/// Returns whether the run was looped to reach the minimum length.
+pub fn write_wav(
+    x: &[f64],
+    fs: f64,
+    path: &Path,
+    float: bool,
+) -> Result<squeal_signal::AudioClip, RunError> {
+    let clip = squeal_signal::render_audio(x, fs, &squeal_signal::AudioOptions::default())
+        .map_err(|e| RunError::Io(format!("audio rendering failed: {e}")))?;
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: clip.sample_rate,
+        bits_per_sample: if float { 32 } else { 16 },
+        sample_format: if float {
+            hound::SampleFormat::Float
+        } else {
+            hound::SampleFormat::Int
+        },
+    };
+    let io = |e: hound::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
+    let mut w = hound::WavWriter::create(path, spec).map_err(io)?;
+    for &s in &clip.samples {
+        if float {
+            w.write_sample(s).map_err(io)?;
+        } else {
+            w.write_sample((s.clamp(-1.0, 1.0) * 32767.0).round() as i16)
+                .map_err(io)?;
+        }
+    }
+    w.finalize().map_err(io)?;
+    Ok(clip)
+}
