@@ -5,12 +5,15 @@
 //! of `MODEL.md` made executable:
 //!
 //! - [`friction`]: friction laws μ(v) (thesis, Coulomb, Stribeck, rational);
-//! - [`model`]: the disc–pad model of the thesis and the mass on a belt, as
+//! - [`model`]: the disc–pad model of the thesis, the mass on a belt and the
+//!   Hoffmann et al. (2002) mode-coupling model, as
 //!   plug-ins (a vector field per contact mode, guards, transition rules);
 //! - [`integrate`]: an event-driven DOP853 integrator that locates every
 //!   stick, slip, reversal, separation and contact on the dense output;
 //! - [`sink`]: where a run's samples and events go;
-//! - [`initial`]: initial states (`rest`, `equilibrium`, offsets).
+//! - [`initial`]: initial states (`rest`, `equilibrium`, offsets);
+//! - [`stability`]: linear stability of steady sliding (eigenvalues of the
+//!   state matrix, critical parameter values).
 //!
 //! The crate is pure computation: no files, no threads, no clocks.
 
@@ -20,8 +23,13 @@ pub mod integrate;
 pub mod model;
 pub mod params;
 pub mod sink;
+pub mod stability;
 
 pub use friction::FrictionLaw;
 pub use integrate::{simulate, Flow, IntegrateError, RunInfo, Sink, Solver, SolverOptions, Stats};
-pub use model::{belt::Belt, disc_pad::DiscPad, EventKind, Mode, Model, ModelError, Parameters};
+pub use model::{
+    belt::Belt, disc_pad::DiscPad, hoffmann::Hoffmann, EventKind, Mode, Model, ModelError,
+    Parameters,
+};
 pub use params::{ParamError, ParamSpec};
+pub use stability::{analyse, critical, max_growth_rate, Analysis, StabilityError};

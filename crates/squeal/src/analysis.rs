@@ -38,8 +38,6 @@ pub struct Analysis {
     pub growth: Vec<(String, f64, f64, f64, f64)>,
     /// One word: decays, grows, limit-cycle, stick-slip.
     pub verdict: Verdict,
-    /// Whether stick or reversal events occur in the last quarter of the run.
-    pub stick_slip_in_tail: bool,
 }
 
 fn spectrum_of(name: &str, x: &[f64], fs: f64) -> Option<ChannelSpectrum> {
@@ -87,7 +85,6 @@ pub fn analyse(run: &Run, ch: &Channels) -> Analysis {
         .any(|(t, k)| *t >= tail_start && matches!(k, EventKind::Stick | EventKind::Reverse));
     let stick_flag = if stick_slip_in_tail { 1.0 } else { 0.0 };
     let mut growth = Vec::new();
-    let mut verdicts = Vec::new();
     for (name, col) in run.columns.iter().zip(&run.data) {
         if !name.starts_with('v') || name == "v_rel" {
             continue;
@@ -103,22 +100,48 @@ pub fn analyse(run: &Run, ch: &Channels) -> Analysis {
                 ));
             }
         }
-        if let Ok(c) = squeal_signal::classify_with(col, fs, stick_flag, &VerdictOptions::default())
-        {
-            verdicts.push(c.verdict);
-        }
     }
+    // The verdict is about the friction-excited (tangential) motion; only when
+    // there is none (a disc at rest) does it describe the normal motion. A
+    // steady tail is one whose level changes by less than 0.25 dB: slow decays
+    // (the disc's ≈ 0.5 1/s) must not pass for limit cycles.
+    let opts = VerdictOptions {
+        steady_tol_db: 0.25,
+        ..VerdictOptions::default()
+    };
+    let moving = |name: &str| {
+        run.column(name)
+            .is_some_and(|x| x.iter().any(|v| *v != 0.0))
+    };
+    let velocity = |name: &str| name.starts_with('v') && name != "v_rel";
+    let tangential_cols: Vec<&String> = run
+        .columns
+        .iter()
+        .filter(|n| velocity(n) && (n.starts_with("vx") || n.as_str() == "v") && moving(n))
+        .collect();
+    let chosen: Vec<&String> = if tangential_cols.is_empty() {
+        run.columns
+            .iter()
+            .filter(|n| velocity(n) && moving(n))
+            .collect()
+    } else {
+        tangential_cols
+    };
+    let verdicts: Vec<Verdict> = chosen
+        .iter()
+        .filter_map(|n| run.column(n))
+        .filter_map(|x| squeal_signal::classify_with(x, fs, stick_flag, &opts).ok())
+        .map(|c| c.verdict)
+        .collect();
     // The system's verdict: growing anywhere beats a steady oscillation, which beats decay.
     let verdict = if verdicts.contains(&Verdict::Grows) {
         Verdict::Grows
-    } else if verdicts.contains(&Verdict::StickSlip) {
+    } else if verdicts.contains(&Verdict::StickSlip)
+        || (stick_slip_in_tail && verdicts.contains(&Verdict::LimitCycle))
+    {
         Verdict::StickSlip
     } else if verdicts.contains(&Verdict::LimitCycle) {
-        if stick_slip_in_tail {
-            Verdict::StickSlip
-        } else {
-            Verdict::LimitCycle
-        }
+        Verdict::LimitCycle
     } else {
         Verdict::Decays
     };
@@ -127,7 +150,6 @@ pub fn analyse(run: &Run, ch: &Channels) -> Analysis {
         normal,
         growth,
         verdict,
-        stick_slip_in_tail,
     }
 }
 

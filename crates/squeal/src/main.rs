@@ -38,6 +38,12 @@ pub struct ScenarioArgs {
 enum Command {
     /// Integrate a scenario and write series.csv, events.csv and summary.json.
     Simulate(commands::simulate::SimulateArgs),
+    /// Eigen-analysis of steady sliding: every mode's growth rate, frequency, damping.
+    Stability(commands::stability::StabilityArgs),
+    /// Stability map over a grid of two parameters (linear, or --transient by simulation).
+    Map(commands::map::MapArgs),
+    /// Locate the parameter value where steady sliding changes stability.
+    Critical(commands::critical::CriticalArgs),
     /// Redraw the pictures of a saved run without re-simulating.
     Plot(commands::plot::PlotArgs),
     /// Render a velocity as a WAV file (from a saved run or a scenario).
@@ -55,6 +61,9 @@ fn main() -> ExitCode {
         Command::Simulate(a) => commands::simulate::run(a),
         Command::Scenario { what } => commands::scenario::run(what),
         Command::Plot(a) => commands::plot::run(a),
+        Command::Stability(a) => commands::stability::run(a),
+        Command::Map(a) => commands::map::run(a),
+        Command::Critical(a) => commands::critical::run(a),
         Command::Listen(a) => commands::listen::run(a),
     };
     match result {

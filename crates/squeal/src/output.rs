@@ -210,7 +210,7 @@ pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
         )));
     };
     let sample_rate = summary["scenario"]["sample_rate"].as_f64().unwrap_or(0.0);
-    if !(sample_rate > 0.0) {
+    if sample_rate.is_nan() || sample_rate <= 0.0 {
         return Err(bad(format!(
             "{}: no scenario.sample_rate",
             summary_path.display()

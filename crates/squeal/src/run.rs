@@ -55,10 +55,6 @@ impl Run {
     pub fn len(&self) -> usize {
         self.data.first().map_or(0, Vec::len)
     }
-    /// Whether the run has no samples.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
 }
 
 struct Collect<'a, M> {
@@ -167,12 +163,6 @@ fn run_model<M: Model<N>, const N: usize>(
 /// Integrate a scenario, with a progress bar on a terminal.
 pub fn run(sc: &Scenario) -> Result<Run, RunError> {
     let pb = progress_bar(1000, &format!("simulating {}", sc.name));
-    with_model!(&sc.model, m => run_model(m, &sc.model, sc, &pb))
-}
-
-/// Integrate a scenario quietly (for sweeps).
-pub fn run_quiet(sc: &Scenario) -> Result<Run, RunError> {
-    let pb = ProgressBar::hidden();
     with_model!(&sc.model, m => run_model(m, &sc.model, sc, &pb))
 }
 

@@ -8,6 +8,7 @@
 
 pub mod belt;
 pub mod disc_pad;
+pub mod hoffmann;
 
 use crate::params::{ParamError, ParamSpec};
 

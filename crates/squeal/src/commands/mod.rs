@@ -1,6 +1,9 @@
 //! One module per command.
 
+pub mod critical;
 pub mod listen;
+pub mod map;
 pub mod plot;
 pub mod scenario;
 pub mod simulate;
+pub mod stability;

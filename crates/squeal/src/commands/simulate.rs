@@ -149,12 +149,17 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
             parts.join(", ")
         );
     }
-    if let Some(t) = summary["spectrum"]["tangential"]["dominant_hz"].as_f64() {
-        let n = summary["spectrum"]["normal"]["dominant_hz"].as_f64();
-        match n {
-            Some(n) => println!("dominant frequencies: tangential {t:.1} Hz, normal {n:.1} Hz"),
-            None => println!("dominant frequency: {t:.1} Hz"),
-        }
+    let fmt = |k: &str| {
+        summary["spectrum"][k]["dominant_hz"]
+            .as_f64()
+            .map(|f| format!("{k} {f:.1} Hz"))
+    };
+    let dom: Vec<String> = ["tangential", "normal"]
+        .iter()
+        .filter_map(|k| fmt(k))
+        .collect();
+    if !dom.is_empty() {
+        println!("dominant frequencies: {}", dom.join(", "));
     }
     println!("verdict: {}", summary["verdict"].as_str().unwrap_or("?"));
     println!("output: {}", dest.display());

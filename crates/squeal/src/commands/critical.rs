@@ -1,0 +1,133 @@
+//! `squeal critical [SCENARIO] --param NAME=LO:HI [--json]`: the parameter
+//! value where steady sliding changes stability (a Hopf point, or the onset
+//! of undamped mode coupling), by bracketing and Brent's method.
+
+use crate::commands::simulate::resolve;
+use crate::commands::stability::stability_error;
+use crate::model::AnyModel;
+use crate::run::RunError;
+use crate::scenario::InputError;
+use crate::ScenarioArgs;
+use clap::Args;
+use serde_json::json;
+use squeal_core::stability::{self, CriticalOptions, Crossing, Direction, StabilityError};
+
+/// Arguments of `squeal critical`.
+#[derive(Args, Debug)]
+pub struct CriticalArgs {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
+    /// The parameter and its search interval, e.g. V=0:20 or c_px=0:10.
+    #[arg(long, value_name = "NAME=LO:HI", allow_hyphen_values = true)]
+    param: String,
+    /// Points of the initial scan of the interval.
+    #[arg(long, default_value_t = 64)]
+    grid: usize,
+    /// Print {"param", "value", "freq_hz"} as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+/// Parse `NAME=LO:HI`.
+pub fn parse_interval(spec: &str, flag: &str) -> Result<(String, f64, f64), InputError> {
+    let bad = || {
+        InputError(format!(
+            "{flag} {spec}: expected NAME=LO:HI with numbers LO < HI"
+        ))
+    };
+    let (name, range) = spec.split_once('=').ok_or_else(bad)?;
+    let (lo, hi) = range.split_once(':').ok_or_else(bad)?;
+    let (lo, hi): (f64, f64) = (
+        lo.trim().parse().map_err(|_| bad())?,
+        hi.trim().parse().map_err(|_| bad())?,
+    );
+    if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+        return Err(bad());
+    }
+    Ok((name.trim().to_string(), lo, hi))
+}
+
+/// Least stable growth rate and its frequency with `name` set to `value`.
+pub fn growth_at(model: &AnyModel, name: &str, value: f64) -> Result<(f64, f64), StabilityError> {
+    let mut m = *model;
+    m.set(name, value)?;
+    m.validate()?;
+    crate::with_model!(&m, mm => stability::max_growth_rate(mm))
+}
+
+/// Locate the crossing of `name` in `[lo, hi]`.
+pub fn locate(
+    model: &AnyModel,
+    name: &str,
+    lo: f64,
+    hi: f64,
+    grid: usize,
+) -> Result<Option<Crossing>, RunError> {
+    if model.get(name).is_none() {
+        return Err(InputError(format!(
+            "--param {name}: unknown parameter for model {}",
+            model.name()
+        ))
+        .into());
+    }
+    let opts = CriticalOptions {
+        grid,
+        ..CriticalOptions::default()
+    };
+    // A range that starts where there is no steady sliding (V = 0, say) starts
+    // just inside, where there is.
+    let mut lo = lo;
+    if let Err(StabilityError::NoSteadySliding(_)) = growth_at(model, name, lo) {
+        let nudged = lo + (hi - lo) * 1e-9;
+        if growth_at(model, name, nudged).is_ok() {
+            lo = nudged;
+        }
+    }
+    stability::critical(|p| growth_at(model, name, p), lo, hi, &opts).map_err(stability_error)
+}
+
+/// Run the command.
+pub fn run(a: CriticalArgs) -> Result<(), RunError> {
+    let sc = resolve(&a.scenario)?;
+    let (name, lo, hi) = parse_interval(&a.param, "--param")?;
+    if a.grid < 2 {
+        return Err(InputError(format!("--grid {}: must be ≥ 2", a.grid)).into());
+    }
+    let found = locate(&sc.model, &name, lo, hi, a.grid)?;
+    if a.json {
+        let doc = match &found {
+            Some(c) => json!({
+                "param": name, "value": c.value, "freq_hz": c.freq_hz,
+                "direction": c.direction, "from_neutral": c.from_neutral,
+            }),
+            None => json!({ "param": name, "value": null, "freq_hz": null }),
+        };
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
+        );
+        return Ok(());
+    }
+    match found {
+        None => println!(
+            "{}: no change of stability for {name} in [{lo}, {hi}]",
+            sc.name
+        ),
+        Some(c) => {
+            let side = match c.direction {
+                Direction::Destabilising => "unstable above, stable below",
+                Direction::Stabilising => "stable above, unstable below",
+            };
+            let kind = if c.from_neutral {
+                "onset of mode coupling"
+            } else {
+                "Hopf point"
+            };
+            println!(
+                "{}: critical {name} = {:.12e} ({kind}; {side}); the crossing mode is at {:.3} Hz",
+                sc.name, c.value, c.freq_hz
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,115 @@
+//! `squeal stability [SCENARIO] [--set …] [--json]`: every eigenvalue of the
+//! steady-sliding state, each mode's growth rate, frequency, damping ratio and
+//! dominant coordinate, and the verdict (MODEL.md §5).
+
+use crate::commands::simulate::resolve;
+use crate::model::AnyModel;
+use crate::run::RunError;
+use crate::scenario::InputError;
+use crate::ScenarioArgs;
+use clap::Args;
+use serde_json::{json, Value};
+use squeal_core::stability::{self, Analysis, StabilityError};
+
+/// Arguments of `squeal stability`.
+#[derive(Args, Debug)]
+pub struct StabilityArgs {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
+    /// Print a JSON document on stdout instead of the table.
+    #[arg(long)]
+    json: bool,
+}
+
+/// A stability failure as a command error: no steady sliding or bad
+/// parameters are input errors (exit 2), anything else a run failure.
+pub fn stability_error(e: StabilityError) -> RunError {
+    match e {
+        StabilityError::NoSteadySliding(_)
+        | StabilityError::Param(_)
+        | StabilityError::BadInterval { .. } => RunError::Input(InputError(e.to_string())),
+        other => RunError::Numerical(other.to_string()),
+    }
+}
+
+/// Full analysis of any model, with mass-weighted mode attribution.
+pub fn analyse(model: &AnyModel) -> Result<Analysis, StabilityError> {
+    use squeal_core::stability::Inertia;
+    crate::with_model!(model, m => stability::analyse_with_masses(m, &m.position_masses()))
+}
+
+/// The JSON document of an analysis.
+pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
+    let eig: Vec<Value> = an
+        .eigen
+        .iter()
+        .map(|e| {
+            json!({
+                "re": e.re, "im": e.im, "freq_hz": e.freq_hz,
+                "damping_ratio": e.damping_ratio, "dominant": e.dominant_name, "growing": e.growing,
+            })
+        })
+        .collect();
+    let names = model.state_names();
+    let eq: serde_json::Map<String, Value> = names
+        .iter()
+        .zip(&an.equilibrium)
+        .map(|(n, v)| (n.to_string(), json!(v)))
+        .collect();
+    let ls = an.least_stable_mode();
+    json!({
+        "eigenvalues": eig,
+        "max_growth_rate": an.max_growth_rate,
+        "stable": an.stable,
+        "least_stable": { "re": ls.re, "im": ls.im, "freq_hz": ls.freq_hz, "dominant": ls.dominant_name },
+        "equilibrium": eq,
+    })
+}
+
+/// Run the command.
+pub fn run(a: StabilityArgs) -> Result<(), RunError> {
+    let sc = resolve(&a.scenario)?;
+    let an = analyse(&sc.model).map_err(stability_error)?;
+    if a.json {
+        let mut doc = analysis_json(&sc.model, &an);
+        doc["scenario"] = sc.to_json();
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
+        );
+        return Ok(());
+    }
+    let verdict = if an.stable {
+        "STABLE"
+    } else {
+        "UNSTABLE: it squeals"
+    };
+    println!(
+        "{} ({}): steady sliding is {verdict} (max growth rate {:+.6e} 1/s)",
+        sc.name,
+        sc.model.name(),
+        an.max_growth_rate
+    );
+    println!(
+        "{:>3}  {:>15}  {:>15}  {:>12}  {:>14}  dominant",
+        "#", "σ (1/s)", "ω (rad/s)", "freq (Hz)", "damping ratio"
+    );
+    for (i, e) in an.eigen.iter().enumerate() {
+        println!(
+            "{:>3}  {:>+15.6e}  {:>+15.6e}  {:>12.2}  {:>+14.4e}  {}{}",
+            i + 1,
+            e.re,
+            e.im,
+            e.freq_hz,
+            e.damping_ratio,
+            e.dominant_name,
+            if e.growing { "  grows" } else { "" }
+        );
+    }
+    let ls = an.least_stable_mode();
+    println!(
+        "least stable mode: {:.2} Hz, dominated by {}, σ = {:+.6e} 1/s",
+        ls.freq_hz, ls.dominant_name, ls.re
+    );
+    Ok(())
+}

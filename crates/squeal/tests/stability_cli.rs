@@ -1,0 +1,152 @@
+//! `squeal stability`, `critical` and `map` end to end.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn squeal_env(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_squeal"));
+    c.current_dir(dir).args(args);
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("squeal runs")
+}
+
+fn squeal(dir: &Path, args: &[&str]) -> Output {
+    let out = squeal_env(dir, args, &[]);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON only")
+}
+
+#[test]
+fn stability_lists_all_eigenvalues_of_the_default_brake() {
+    let d = tempfile::tempdir().unwrap();
+    let j = json(&squeal(d.path(), &["stability", "--json"]));
+    let ev = j["eigenvalues"].as_array().unwrap();
+    assert_eq!(ev.len(), 8, "2n eigenvalues for 4 DOF");
+    assert_eq!(j["stable"], false);
+    // MODEL.md §5: pad tangential 20.75 kHz with σ ≈ +14.7 1/s is the least stable.
+    let max = j["max_growth_rate"].as_f64().unwrap();
+    assert!((max - 14.6667).abs() < 1e-3, "{max}");
+    assert_eq!(ev[0]["dominant"], "x_p");
+    assert!((ev[0]["freq_hz"].as_f64().unwrap() - 20751.0).abs() < 2.0);
+    let rates: Vec<f64> = ev.iter().map(|e| e["re"].as_f64().unwrap()).collect();
+    assert!(
+        rates.windows(2).all(|w| w[0] >= w[1]),
+        "sorted by growth rate"
+    );
+    let text = String::from_utf8_lossy(&squeal(d.path(), &["stability"]).stdout).to_string();
+    assert!(text.contains("UNSTABLE") && text.contains("x_p"), "{text}");
+    // No steady sliding: a clear input error.
+    let out = squeal_env(d.path(), &["stability", "--set", "V=0"], &[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("V = 0"));
+}
+
+#[test]
+fn critical_speed_of_the_belt_matches_the_closed_form() {
+    let d = tempfile::tempdir().unwrap();
+    // belt built-in: thesis law (f0 = 0.1, f1 = 1/15, Uc = 50/3), c = 0.2, N = 100.
+    let j = json(&squeal(
+        d.path(),
+        &["critical", "belt", "--param", "V=0:30", "--json"],
+    ));
+    let want = 50.0 / 3.0 * (1.0 - 0.2 / (100.0 * 0.1 / 15.0));
+    let got = j["value"].as_f64().unwrap();
+    assert!((got - want).abs() <= 1e-9 * want, "{got} vs {want}");
+    assert_eq!(j["param"], "V");
+    // No crossing in range: value null, exit 0.
+    let j = json(&squeal(
+        d.path(),
+        &["critical", "belt", "--param", "V=12:30", "--json"],
+    ));
+    assert!(j["value"].is_null());
+    let out = squeal_env(d.path(), &["critical", "--param", "bogus=0:1"], &[]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn map_is_identical_single_and_multi_threaded() {
+    let d = tempfile::tempdir().unwrap();
+    let args = |out: &'static str| {
+        vec![
+            "map",
+            "--x",
+            "V=0.5:20:41",
+            "--y",
+            "N=100:3000:31",
+            "--log-y",
+            "--out",
+            out,
+        ]
+    };
+    let one = squeal_env(d.path(), &args("one"), &[("RAYON_NUM_THREADS", "1")]);
+    assert!(
+        one.status.success(),
+        "{}",
+        String::from_utf8_lossy(&one.stderr)
+    );
+    let two = squeal_env(d.path(), &args("two"), &[("RAYON_NUM_THREADS", "2")]);
+    assert!(two.status.success());
+    let a = std::fs::read_to_string(d.path().join("one/map.csv")).unwrap();
+    let b = std::fs::read_to_string(d.path().join("two/map.csv")).unwrap();
+    assert_eq!(a, b);
+    assert_eq!(a.lines().next().unwrap(), "V,N,max_growth_rate,freq_hz");
+    assert_eq!(a.lines().count(), 1 + 41 * 31);
+    assert!(d.path().join("one/map.png").is_file() && d.path().join("one/map.svg").is_file());
+    // Above Uc every point is stable (conclusion 3); below, at N = 500, unstable.
+    for line in a.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        if v[0] > 50.0 / 3.0 {
+            assert!(v[2] < 0.0, "{line}");
+        }
+    }
+}
+
+#[test]
+fn transient_map_classifies_by_simulation() {
+    let d = tempfile::tempdir().unwrap();
+    let out = squeal(
+        d.path(),
+        &[
+            "map",
+            "belt",
+            "--x",
+            "V=2:16:3",
+            "--y",
+            "c=0.05:1:2",
+            "--transient",
+            "--duration",
+            "4",
+            "--out",
+            "t",
+            "--json",
+        ],
+    );
+    let j = json(&out);
+    assert_eq!(j["points"], 6);
+    let csv = std::fs::read_to_string(d.path().join("t/map.csv")).unwrap();
+    assert_eq!(
+        csv.lines().next().unwrap(),
+        "V,c,max_growth_rate,freq_hz,outcome,rms_tangential,stick_fraction,t_end"
+    );
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let sigma: f64 = f[2].parse().unwrap();
+        let outcome = f[4];
+        // Linearly stable points decay; unstable ones end in stick-slip.
+        if sigma < -0.05 {
+            assert_eq!(outcome, "decays", "{line}");
+        } else if sigma > 0.05 {
+            assert!(outcome == "stick-slip" || outcome == "grows", "{line}");
+        }
+    }
+}
