@@ -26,7 +26,7 @@ struct Cli {
 /// The scenario and its overrides, shared by every command that runs a model.
 #[derive(Args, Debug, Clone)]
 pub struct ScenarioArgs {
-    /// A built-in scenario name (disc-pad, belt-coulomb, belt) or a TOML file.
+    /// A built-in scenario name (disc-pad, belt-coulomb, belt, hoffmann) or a TOML file.
     #[arg(default_value = "disc-pad")]
     pub scenario: String,
     /// Override a parameter or setting: --set N=2000 --set friction=coulomb (repeatable).

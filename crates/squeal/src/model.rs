@@ -1,7 +1,7 @@
 //! The models the command line knows, behind one enum, with their output columns.
 
 use squeal_core::model::Observables;
-use squeal_core::{Belt, DiscPad, Mode, Model, ParamError, ParamSpec, Parameters};
+use squeal_core::{Belt, DiscPad, Hoffmann, Mode, Model, ParamError, ParamSpec, Parameters};
 
 /// Any model squeal can run. Adding a model: one variant here and one arm in
 /// [`with_model!`]; the integrator and the commands stay unchanged.
@@ -11,6 +11,8 @@ pub enum AnyModel {
     DiscPad(DiscPad),
     /// The 1-DOF mass on a moving belt.
     Belt(Belt),
+    /// The 2-DOF mode-coupling model of Hoffmann et al. (2002).
+    Hoffmann(Hoffmann),
 }
 
 /// Run `$body` with `$m` bound to the concrete model (generic code inside).
@@ -20,12 +22,13 @@ macro_rules! with_model {
         match $any {
             $crate::model::AnyModel::DiscPad($m) => $body,
             $crate::model::AnyModel::Belt($m) => $body,
+            $crate::model::AnyModel::Hoffmann($m) => $body,
         }
     };
 }
 
 /// Names of the models, as typed in a scenario's `model` key.
-pub const MODEL_NAMES: [&str; 2] = ["disc-pad", "belt"];
+pub const MODEL_NAMES: [&str; 3] = ["disc-pad", "belt", "hoffmann"];
 
 impl AnyModel {
     /// The model called `name` with its defaults.
@@ -33,6 +36,7 @@ impl AnyModel {
         match name {
             "disc-pad" => Some(AnyModel::DiscPad(DiscPad::default())),
             "belt" => Some(AnyModel::Belt(Belt::default())),
+            "hoffmann" => Some(AnyModel::Hoffmann(Hoffmann::default())),
             _ => None,
         }
     }
@@ -49,12 +53,13 @@ impl AnyModel {
         match self {
             AnyModel::DiscPad(_) => &["F_y", "F_t", "v_rel", "mode"],
             AnyModel::Belt(_) => &["F_t", "v_rel", "mode"],
+            AnyModel::Hoffmann(_) => &["N", "F_t", "v_rel", "mode"],
         }
     }
     /// Derived values matching [`Self::derived_columns`] (the mode flag last).
     pub fn derived_values(&self, obs: &Observables, mode: Mode, out: &mut Vec<f64>) {
         out.clear();
-        if let AnyModel::DiscPad(_) = self {
+        if let AnyModel::DiscPad(_) | AnyModel::Hoffmann(_) = self {
             out.push(obs.normal_force);
         }
         out.push(obs.friction_force);

@@ -48,7 +48,7 @@ pub struct Scenario {
 }
 
 /// Names of the built-in scenarios.
-pub const BUILTINS: [&str; 3] = ["disc-pad", "belt-coulomb", "belt"];
+pub const BUILTINS: [&str; 4] = ["disc-pad", "belt-coulomb", "belt", "hoffmann"];
 
 impl Scenario {
     /// A built-in scenario by name.
@@ -101,6 +101,19 @@ impl Scenario {
                 s.sample_rate = 1000.0;
                 s.initial = Initial::Equilibrium;
                 s.offsets[1] = 1e-3;
+                s.solver.atol_pos = Some(1e-12);
+                s.solver.atol_vel = Some(1e-10);
+                s
+            }
+            "hoffmann" => {
+                let mut s = base(
+                    AnyModel::by_name("hoffmann").unwrap(),
+                    "Hoffmann et al.'s 2-DOF mode-coupling model above its critical friction: flutter grows into a limit cycle.",
+                );
+                s.duration = 5.0;
+                s.sample_rate = 2000.0;
+                s.initial = Initial::Equilibrium;
+                s.offsets[1] = 1e-4;
                 s.solver.atol_pos = Some(1e-12);
                 s.solver.atol_vel = Some(1e-10);
                 s
