@@ -44,6 +44,8 @@ enum Command {
     Map(commands::map::MapArgs),
     /// Locate the parameter value where steady sliding changes stability.
     Critical(commands::critical::CriticalArgs),
+    /// Re-do the thesis: 40 sets, Appendix A, the seven conclusions checked, a report.
+    Reproduce(commands::reproduce::ReproduceArgs),
     /// Redraw the pictures of a saved run without re-simulating.
     Plot(commands::plot::PlotArgs),
     /// Render a velocity as a WAV file (from a saved run or a scenario).
@@ -61,6 +63,7 @@ fn main() -> ExitCode {
         Command::Simulate(a) => commands::simulate::run(a),
         Command::Scenario { what } => commands::scenario::run(what),
         Command::Plot(a) => commands::plot::run(a),
+        Command::Reproduce(a) => commands::reproduce::run(a),
         Command::Stability(a) => commands::stability::run(a),
         Command::Map(a) => commands::map::run(a),
         Command::Critical(a) => commands::critical::run(a),

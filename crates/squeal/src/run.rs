@@ -163,7 +163,12 @@ fn run_model<M: Model<N>, const N: usize>(
 /// Integrate a scenario, with a progress bar on a terminal.
 pub fn run(sc: &Scenario) -> Result<Run, RunError> {
     let pb = progress_bar(1000, &format!("simulating {}", sc.name));
-    with_model!(&sc.model, m => run_model(m, &sc.model, sc, &pb))
+    run_with(sc, &pb)
+}
+
+/// Integrate a scenario, reporting progress to `pb` (hidden for sweeps).
+pub fn run_with(sc: &Scenario, pb: &ProgressBar) -> Result<Run, RunError> {
+    with_model!(&sc.model, m => run_model(m, &sc.model, sc, pb))
 }
 
 /// An output folder written under a temporary name and renamed into place

@@ -4,6 +4,7 @@ pub mod critical;
 pub mod listen;
 pub mod map;
 pub mod plot;
+pub mod reproduce;
 pub mod scenario;
 pub mod simulate;
 pub mod stability;
