@@ -474,7 +474,7 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
     let (c500, c2000) = sw.c_crit;
     let s28 = find(28);
     let s31 = find(31);
-    let runs_ok = s28.is_some_and(|r| !squeals(r)) && s31.is_some_and(|r| squeals(r));
+    let runs_ok = s28.is_some_and(|r| !squeals(r)) && s31.is_some_and(squeals);
     out.push(Conclusion {
         id: 4,
         thesis: "Below Uc, instability appears when damping is small, more readily at high N.",
