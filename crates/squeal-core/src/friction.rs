@@ -278,6 +278,11 @@ impl FrictionLaw {
     }
 
     /// Friction coefficient μ(v) at sliding speed `v ≥ 0`.
+    ///
+    /// For slightly negative `v` it returns a smooth continuation (the same
+    /// formula; the Stribeck law uses |v|), which the integrator evaluates
+    /// only inside a step that overshoots a slip reversal before the event is
+    /// located: a kink there would make the error estimate reject the step.
     #[inline]
     pub fn mu(&self, v: f64) -> f64 {
         match *self {
@@ -289,7 +294,7 @@ impl FrictionLaw {
                 v_s,
                 delta,
                 sigma,
-            } => mu_k + (mu_s - mu_k) * (-(v / v_s).powf(delta)).exp() + sigma * v,
+            } => mu_k + (mu_s - mu_k) * (-(v.abs() / v_s).powf(delta)).exp() + sigma * v,
             FrictionLaw::Rational { mu_s, delta } => mu_s / (1.0 + delta * v),
         }
     }

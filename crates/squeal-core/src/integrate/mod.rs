@@ -177,6 +177,7 @@ pub struct Solver<'m, M: Model<N>, const N: usize> {
     mode: Mode,
     h: f64,
     last_rejected: bool,
+    err_old: f64,
     k: [[f64; N]; 16],
     /// Dense output of the last segment: y_old and F0..F6.
     y_old: [f64; N],
@@ -253,6 +254,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
             mode,
             h: 0.0,
             last_rejected: false,
+            err_old: 1e-4,
             k: [[0.0; N]; 16],
             y_old: z0,
             dense: [[0.0; N]; 7],
@@ -407,49 +409,68 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
         (100.0 * h0).min(h1).min(self.opts.h_max)
     }
 
+    /// `base + h·Σ_j row[j]·k[j]` over the first `upto` stages, skipping the
+    /// tableau's zeros; the state index is innermost so the loop vectorises.
+    #[inline(always)]
+    fn combine(&self, base: &[f64; N], row: &[f64], upto: usize, h: f64) -> [f64; N] {
+        let mut y = *base;
+        for j in 0..upto {
+            let a = h * row[j];
+            if a != 0.0 {
+                let kj = &self.k[j];
+                for i in 0..N {
+                    y[i] += a * kj[i];
+                }
+            }
+        }
+        y
+    }
+
+    /// [`Self::combine`] over exactly `S` stages of a constant tableau row:
+    /// with `S` and the row known at compile time the loop unrolls and the
+    /// tableau's zeros vanish.
+    #[inline(always)]
+    fn combine_n<const S: usize>(&self, base: &[f64; N], row: &[f64; 16], h: f64) -> [f64; N] {
+        let mut y = *base;
+        for j in 0..S {
+            let a = h * row[j];
+            let kj = &self.k[j];
+            for i in 0..N {
+                y[i] += a * kj[i];
+            }
+        }
+        y
+    }
+
     /// One RK step of size h from the current state; fills `k[0..13]`,
     /// returns the new state and the error norm.
     #[inline]
     fn rk_step(&mut self, h: f64) -> ([f64; N], f64) {
         let (t, z, mode) = (self.t, self.z, self.mode);
         self.k[0] = self.f;
-        let mut y = [0.0; N];
-        for s in 1..12 {
-            for i in 0..N {
-                let mut acc = 0.0;
-                for j in 0..s {
-                    acc += A[s][j] * self.k[j][i];
-                }
-                y[i] = z[i] + h * acc;
-            }
-            let mut ks = [0.0; N];
-            self.rhs(t + C[s] * h, mode, &y, &mut ks);
-            self.k[s] = ks;
+        macro_rules! stage {
+            ($($s:literal)*) => {$(
+                let y = self.combine_n::<$s>(&z, &A[$s], h);
+                let mut ks = [0.0; N];
+                self.rhs(t + C[$s] * h, mode, &y, &mut ks);
+                self.k[$s] = ks;
+            )*};
         }
-        let mut z_new = [0.0; N];
-        for i in 0..N {
-            let mut acc = 0.0;
-            for j in 0..12 {
-                acc += B[j] * self.k[j][i];
-            }
-            z_new[i] = z[i] + h * acc;
-        }
+        stage!(1 2 3 4 5 6 7 8 9 10 11);
+        let z_new = self.combine(&z, &B, 12, h);
         let mut f_new = [0.0; N];
         self.rhs(t + h, mode, &z_new, &mut f_new);
         self.k[12] = f_new;
         // Error estimate (Hairer's DOP853: 5th- and 3rd-order embedded errors).
+        let zero = [0.0; N];
+        let e5 = self.combine(&zero, &E5, 13, 1.0);
+        let e3 = self.combine(&zero, &E3, 13, 1.0);
         let mut err5 = 0.0;
         let mut err3 = 0.0;
         for i in 0..N {
             let sk = self.atol[i] + self.opts.rtol * z[i].abs().max(z_new[i].abs());
-            let mut e5 = 0.0;
-            let mut e3 = 0.0;
-            for j in 0..13 {
-                e5 += E5[j] * self.k[j][i];
-                e3 += E3[j] * self.k[j][i];
-            }
-            err5 += (e5 / sk).powi(2);
-            err3 += (e3 / sk).powi(2);
+            err5 += (e5[i] / sk).powi(2);
+            err3 += (e3[i] / sk).powi(2);
         }
         let err = if err5 == 0.0 && err3 == 0.0 {
             0.0
@@ -463,18 +484,18 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
     #[inline]
     fn build_dense(&mut self, h: f64, z_new: &[f64; N]) {
         let (t, z, mode) = (self.t, self.z, self.mode);
-        let mut y = [0.0; N];
-        for s in 13..16 {
-            for i in 0..N {
-                let mut acc = 0.0;
-                for j in 0..s {
-                    acc += A[s][j] * self.k[j][i];
-                }
-                y[i] = z[i] + h * acc;
-            }
-            let mut ks = [0.0; N];
-            self.rhs(t + C[s] * h, mode, &y, &mut ks);
-            self.k[s] = ks;
+        macro_rules! stage {
+            ($($s:literal)*) => {$(
+                let y = self.combine_n::<$s>(&z, &A[$s], h);
+                let mut ks = [0.0; N];
+                self.rhs(t + C[$s] * h, mode, &y, &mut ks);
+                self.k[$s] = ks;
+            )*};
+        }
+        stage!(13 14 15);
+        let zero = [0.0; N];
+        for r in 0..4 {
+            self.dense[3 + r] = self.combine(&zero, &D[r], 16, h);
         }
         for i in 0..N {
             let dy = z_new[i] - z[i];
@@ -483,13 +504,6 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
             self.dense[0][i] = dy;
             self.dense[1][i] = h * f_old - dy;
             self.dense[2][i] = 2.0 * dy - h * (f_new + f_old);
-            for r in 0..4 {
-                let mut acc = 0.0;
-                for j in 0..16 {
-                    acc += D[r][j] * self.k[j][i];
-                }
-                self.dense[3 + r][i] = h * acc;
-            }
         }
         self.y_old = z;
         self.t_old = t;
@@ -579,6 +593,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
         const SAFE: f64 = 0.9;
         const FAC_MIN: f64 = 1.0 / 3.0; // step may shrink to a third…
         const FAC_MAX: f64 = 6.0; // …or grow sixfold
+        const BETA: f64 = 0.04; // PI stabilisation (0 = the elementary controller)
         let (z_new, h) = loop {
             let mut h = self.h.min(self.opts.h_max);
             let remaining = t_stop - self.t;
@@ -601,8 +616,15 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
                 self.last_rejected = true;
                 continue;
             }
-            let fac = (err.powf(1.0 / 8.0) / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+            // Proportional-integral step control (Gustafsson; Hairer–Nørsett–
+            // Wanner II.4 and the DOP853 code's BETA): the memory of the last
+            // accepted error damps the controller's oscillation on this
+            // oscillatory problem, which otherwise rejects one step in five.
+            let fac11 = err.powf(1.0 / 8.0 - 0.75 * BETA);
             if err <= 1.0 {
+                let fac =
+                    (fac11 / self.err_old.powf(BETA) / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+                self.err_old = err.max(1e-4);
                 let mut h_new = h / fac;
                 if self.last_rejected {
                     h_new = h_new.min(h);
@@ -614,7 +636,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
             }
             self.stats.rejected += 1;
             self.last_rejected = true;
-            self.h = h / (err.powf(1.0 / 8.0) / SAFE).min(1.0 / FAC_MIN);
+            self.h = h / (fac11 / SAFE).min(1.0 / FAC_MIN);
         };
         self.stats.accepted += 1;
         self.build_dense(h, &z_new);

@@ -116,7 +116,8 @@ impl Model<2> for Belt {
             Mode::Stick => 0.0,
             Mode::Free => (-p.k * z[0] - p.c * z[1]) / p.m,
             _ => {
-                let v = (p.V - z[1]).abs();
+                // s·v, not |v|: smooth past the guard (see FrictionLaw::mu).
+                let v = mode.slip_sign() * (p.V - z[1]);
                 (-p.k * z[0] - p.c * z[1] + mode.slip_sign() * self.friction.mu(v) * p.N) / p.m
             }
         };

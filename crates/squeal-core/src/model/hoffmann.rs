@@ -276,7 +276,8 @@ impl Model<4> for Hoffmann {
             Mode::Free => spring_x / p.m,
             Mode::SlipPos | Mode::SlipNeg => {
                 let n = self.normal_force(z).max(0.0);
-                let v = self.sliding_velocity(z).abs();
+                // s·v, not |v|: smooth past the guard (see FrictionLaw::mu).
+                let v = mode.slip_sign() * self.sliding_velocity(z);
                 (spring_x + mode.slip_sign() * self.friction.mu(v) * n) / p.m
             }
         };
