@@ -16,6 +16,23 @@
 //!   state matrix, critical parameter values).
 //!
 //! The crate is pure computation: no files, no threads, no clocks.
+//!
+//! ```
+//! use squeal_core::sink::Recorder;
+//! use squeal_core::{simulate, stability, DiscPad, EventKind, SolverOptions};
+//!
+//! // The thesis's brake with MODEL.md's defaults: linearly unstable…
+//! let brake = DiscPad::default();
+//! let linear = stability::analyse(&brake).unwrap();
+//! assert!(!linear.stable);
+//! assert!((linear.max_growth_rate - 14.667).abs() < 1e-3); // the pad's 20.75 kHz mode
+//!
+//! // …and 10 ms of it from rest, sampled at 20 kHz, every event located.
+//! let mut rec = Recorder::<8>::new();
+//! let run = simulate(&brake, 0.0, [0.0; 8], 0.01, 20_000.0, SolverOptions::default(), &mut rec).unwrap();
+//! assert_eq!(rec.t.len(), 201);
+//! assert_eq!(run.stats.event_count(EventKind::Reverse), 0); // too early for stick-slip
+//! ```
 
 pub mod friction;
 pub mod initial;

@@ -396,3 +396,121 @@ fn bilateral_contact_never_separates() {
         .iter()
         .all(|e| e.kind != EventKind::Separate && e.kind != EventKind::Contact));
 }
+
+/// N ramped linearly over t_ramp: with heavy normal damping the disc follows
+/// the load quasi-statically, y_d(t) ≈ −N(t)/k_dy, and the end of the ramp is
+/// a step boundary (no step crosses it).
+#[test]
+fn ramped_load_is_followed_quasi_statically() {
+    let mut m = DiscPad::default();
+    for (k, v) in [
+        ("t_ramp", 0.02),
+        ("c_dy", 2.0e4),
+        ("c_py", 2.0e3),
+        ("V", 0.0),
+    ] {
+        m.set(k, v).unwrap();
+    }
+    assert_eq!(m.next_breakpoint(0.0), Some(0.02));
+    let mut rec = Recorder::<8>::new();
+    simulate(
+        &m,
+        0.0,
+        [0.0; 8],
+        0.03,
+        10_000.0,
+        SolverOptions::default(),
+        &mut rec,
+    )
+    .unwrap();
+    // Heavily overdamped (ζ ≈ 3.5): the disc's normal motion is the first-order
+    // lag c_dy·ẏ + k_dy·y = −N(t), τ = c_dy/k_dy = 2.5 ms (inertia: m/c = 50 µs).
+    let (tau, k, big_t) = (2.0e4 / 8.0e6, 8.0e6, 0.02);
+    let exact = |t: f64| {
+        let rate = 500.0 / (k * big_t);
+        if t <= big_t {
+            -rate * (t - tau * (1.0 - (-t / tau).exp()))
+        } else {
+            -500.0 / k + rate * tau * (1.0 - (-big_t / tau).exp()) * (-(t - big_t) / tau).exp()
+        }
+    };
+    for (t, z) in rec.t.iter().zip(&rec.z) {
+        let y = exact(*t);
+        assert!(
+            (z[2] - y).abs() <= 0.01 * 500.0 / k,
+            "t = {t}: y_d {} vs {y}",
+            z[2]
+        );
+    }
+    assert_eq!(rec.t.len(), 301);
+}
+
+/// A model whose every mode is left as soon as it is entered: the run must
+/// end with a chatter error that says when, not hang.
+#[test]
+fn endless_chatter_is_reported_with_its_time() {
+    use squeal_core::model::{GuardKind, Guards, ModelError, Observables};
+    use squeal_core::IntegrateError;
+    struct Chatter;
+    impl Model<2> for Chatter {
+        fn name(&self) -> &'static str {
+            "chatter"
+        }
+        fn state_names(&self) -> [&'static str; 2] {
+            ["x", "v"]
+        }
+        fn rhs(&self, _t: f64, mode: Mode, _z: &[f64; 2], dz: &mut [f64; 2]) {
+            // Always pushed towards v = 0 from either side, and back through it.
+            dz[0] = 0.0;
+            dz[1] = -mode.slip_sign();
+        }
+        fn guards(&self, mode: Mode, out: &mut Guards<2>) {
+            out.clear();
+            let s = mode.slip_sign();
+            out.push(GuardKind::SlipZero, [0.0, -s], 0.0);
+        }
+        fn transition(
+            &self,
+            _t: f64,
+            mode: Mode,
+            _g: GuardKind,
+            z: &mut [f64; 2],
+        ) -> (Mode, Option<EventKind>) {
+            z[1] = 0.0;
+            let next = if mode == Mode::SlipPos {
+                Mode::SlipNeg
+            } else {
+                Mode::SlipPos
+            };
+            (next, Some(EventKind::Reverse))
+        }
+        fn initial_mode(&self, _t: f64, _z: &[f64; 2]) -> Mode {
+            Mode::SlipPos
+        }
+        fn observe(&self, _t: f64, _m: Mode, _z: &[f64; 2]) -> Observables {
+            Observables::default()
+        }
+        fn equilibrium(&self) -> Result<[f64; 2], ModelError> {
+            Err(ModelError::NoSteadySliding("test model".into()))
+        }
+        fn jacobian(&self, _z: &[f64; 2]) -> [[f64; 2]; 2] {
+            [[0.0; 2]; 2]
+        }
+    }
+    let mut log = EventLog::<2>::default();
+    let err = simulate(
+        &Chatter,
+        0.0,
+        [0.0, 1e-3],
+        1.0,
+        10.0,
+        SolverOptions::default(),
+        &mut log,
+    )
+    .unwrap_err();
+    match err {
+        IntegrateError::Chatter { t, .. } => assert!((t - 1e-3).abs() < 1e-12, "t = {t}"),
+        other => panic!("expected chatter, got {other:?}"),
+    }
+    assert!(err.to_string().contains("t = 1.000000000e-3"), "{err}");
+}

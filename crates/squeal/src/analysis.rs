@@ -4,13 +4,17 @@
 
 use crate::model::Channels;
 use crate::run::{Run, RunError};
+use crate::scenario::InputError;
 use serde_json::{json, Map, Value};
 use squeal_core::EventKind;
 use squeal_plot::{Format, HeatmapSpec, Labels, Panel, Series};
+use squeal_signal::spectrum::Scaling;
+use squeal_signal::window::Window;
 use squeal_signal::{
-    find_peaks, growth_rate_linear_part, spectrogram, welch, GrowthOptions, Peak, PeakOptions,
-    Spectrum, Verdict, VerdictOptions, WelchOptions,
+    amplitude_spectrum, find_peaks, growth_rate_linear_part, spectrogram, welch, GrowthOptions,
+    Peak, PeakOptions, Spectrum, Verdict, VerdictOptions, WelchOptions,
 };
+use std::fmt::Write as _;
 use std::path::Path;
 
 /// Longest Welch segment (samples): 16384 at 200 kHz resolves 12.2 Hz.
@@ -25,6 +29,8 @@ pub struct ChannelSpectrum {
     pub spectrum: Spectrum,
     /// Strongest peaks, strongest first.
     pub peaks: Vec<Peak>,
+    /// Segment (FFT) length used, samples.
+    pub segment: usize,
 }
 
 /// Spectra, growth and verdict of a run.
@@ -40,15 +46,76 @@ pub struct Analysis {
     pub verdict: Verdict,
 }
 
-fn spectrum_of(name: &str, x: &[f64], fs: f64) -> Option<ChannelSpectrum> {
+/// The spectral analyser's settings (the thesis's analyser had a sample time,
+/// an FFT length, a hop and a buffer; here: window, segment, overlap).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpectrumSettings {
+    /// Window of every segment.
+    pub window: Window,
+    /// Longest segment (FFT length) in samples; shorter runs use their length.
+    pub segment: usize,
+    /// Overlap of consecutive segments, in [0, 0.95].
+    pub overlap: f64,
+    /// Peak-amplitude spectrum ((m/s)², read as amplitude in dB) instead of the PSD.
+    pub amplitude: bool,
+}
+
+impl Default for SpectrumSettings {
+    fn default() -> Self {
+        SpectrumSettings {
+            window: Window::Hann,
+            segment: SEGMENT,
+            overlap: 0.5,
+            amplitude: false,
+        }
+    }
+}
+
+impl SpectrumSettings {
+    /// From command-line flags, checked.
+    pub fn from_flags(
+        window: &str,
+        segment: usize,
+        overlap: f64,
+        amplitude: bool,
+    ) -> Result<Self, InputError> {
+        let window = window.parse::<Window>().map_err(|_| {
+            InputError(format!("--window {window}: expected hann, flattop or rect"))
+        })?;
+        if !(16..=1 << 22).contains(&segment) {
+            return Err(InputError(format!(
+                "--segment {segment}: must be between 16 and 4194304 samples"
+            )));
+        }
+        if !(0.0..=0.95).contains(&overlap) {
+            return Err(InputError(format!(
+                "--overlap {overlap}: must be between 0 and 0.95"
+            )));
+        }
+        Ok(SpectrumSettings {
+            window,
+            segment,
+            overlap,
+            amplitude,
+        })
+    }
+}
+
+fn spectrum_of(name: &str, x: &[f64], fs: f64, set: &SpectrumSettings) -> Option<ChannelSpectrum> {
     if x.len() < 16 {
         return None;
     }
     let opts = WelchOptions {
-        seg_len: Some(SEGMENT.min(x.len())),
+        seg_len: Some(set.segment.min(x.len())),
+        overlap: set.overlap,
+        window: set.window,
         ..WelchOptions::default()
     };
-    let spectrum = welch(x, fs, &opts).ok()?;
+    let spectrum = if set.amplitude {
+        amplitude_spectrum(x, fs, &opts).ok()?
+    } else {
+        welch(x, fs, &opts).ok()?
+    };
     // Peaks within 60 dB of the strongest: below that lies the numerical noise floor.
     let peaks = find_peaks(
         &spectrum,
@@ -62,18 +129,19 @@ fn spectrum_of(name: &str, x: &[f64], fs: f64) -> Option<ChannelSpectrum> {
         signal: name.to_string(),
         spectrum,
         peaks,
+        segment: set.segment.min(x.len()),
     })
 }
 
 /// Analyse a run. Velocities are the columns whose names start with `v`.
-pub fn analyse(run: &Run, ch: &Channels) -> Analysis {
+pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
     let fs = run.sample_rate;
     let tangential = run
         .column(ch.tangential)
-        .and_then(|x| spectrum_of(ch.tangential, x, fs));
+        .and_then(|x| spectrum_of(ch.tangential, x, fs, set));
     let normal = ch
         .normal
-        .and_then(|n| run.column(n).and_then(|x| spectrum_of(n, x, fs)));
+        .and_then(|n| run.column(n).and_then(|x| spectrum_of(n, x, fs, set)));
     let t_end = run
         .column("t")
         .and_then(|t| t.last().copied())
@@ -174,10 +242,17 @@ fn channel_json(c: &Option<ChannelSpectrum>) -> Value {
 impl Analysis {
     /// The `spectrum` key of summary.json.
     pub fn spectrum_json(&self) -> Value {
-        let df = self.tangential.as_ref().map(|c| c.spectrum.df);
+        let df = self
+            .tangential
+            .as_ref()
+            .or(self.normal.as_ref())
+            .map(|c| c.spectrum.df);
+        let first = self.tangential.as_ref().or(self.normal.as_ref());
         json!({
-            "window": "hann",
-            "segment": self.tangential.as_ref().map(|c| (c.spectrum.freq.len() - 1) * 2),
+            "window": first.map(|c| c.spectrum.window.name()),
+            "segment": first.map(|c| c.segment),
+            "segments": first.map(|c| c.spectrum.segments),
+            "scaling": first.map(|c| if c.spectrum.scaling == Scaling::Amplitude { "amplitude" } else { "psd" }),
             "resolution_hz": df,
             "tangential": channel_json(&self.tangential),
             "normal": channel_json(&self.normal),
@@ -194,6 +269,41 @@ impl Analysis {
         }
         Value::Object(m)
     }
+}
+
+/// Write `spectrum.csv`: `freq_hz`, then for each analysed signal its
+/// spectrum (`<signal>_psd` in (m/s)²/Hz, or `<signal>_amp2` in (m/s)² with
+/// `--amplitude`) and the same in dB (`<signal>_db`).
+pub fn write_spectrum_csv(an: &Analysis, path: &Path) -> Result<(), RunError> {
+    let chans: Vec<&ChannelSpectrum> = [&an.tangential, &an.normal].into_iter().flatten().collect();
+    let Some(first) = chans.first() else {
+        return Ok(());
+    };
+    let unit = if first.spectrum.scaling == Scaling::Amplitude {
+        "amp2"
+    } else {
+        "psd"
+    };
+    let mut t = String::from("freq_hz");
+    for c in &chans {
+        let _ = write!(t, ",{0}_{unit},{0}_db", c.signal);
+    }
+    t.push('\n');
+    let dbs: Vec<Vec<f64>> = chans.iter().map(|c| c.spectrum.to_db()).collect();
+    for k in 0..first.spectrum.freq.len() {
+        let _ = write!(t, "{:e}", first.spectrum.freq[k]);
+        for (c, d) in chans.iter().zip(&dbs) {
+            let _ = write!(
+                t,
+                ",{:e},{:e}",
+                c.spectrum.psd.get(k).copied().unwrap_or(f64::NAN),
+                d.get(k).copied().unwrap_or(f64::NAN)
+            );
+        }
+        t.push('\n');
+    }
+    std::fs::write(path, t)
+        .map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))
 }
 
 /// Write the pictures of a run into `dir`: `triplet` (the thesis's three
@@ -236,7 +346,18 @@ pub fn draw(
     let db: Vec<Vec<f64>> = chans.iter().map(|(c, _)| c.spectrum.to_db()).collect();
     let titles: Vec<String> = chans
         .iter()
-        .map(|(c, w)| format!("power spectral density of {} ({w})", c.signal))
+        .map(|(c, w)| {
+            let what = if c.spectrum.scaling == Scaling::Amplitude {
+                "amplitude spectrum"
+            } else {
+                "power spectral density"
+            };
+            format!(
+                "{what} of {} ({w}, {} window)",
+                c.signal,
+                c.spectrum.window.name()
+            )
+        })
         .collect();
     let labels: Vec<Vec<String>> = chans
         .iter()
@@ -249,8 +370,16 @@ pub fn draw(
         })
         .collect();
     for (k, (c, _)) in chans.iter().enumerate() {
-        let mut p = Panel::new(&titles[k], "frequency (Hz)", "PSD (dB re 1 (m/s)²/Hz)")
-            .with_series(Series::new(&c.signal, &c.spectrum.freq, &db[k]));
+        let y_label = if c.spectrum.scaling == Scaling::Amplitude {
+            "amplitude (dB re 1 m/s)"
+        } else {
+            "PSD (dB re 1 (m/s)²/Hz)"
+        };
+        let mut p = Panel::new(&titles[k], "frequency (Hz)", y_label).with_series(Series::new(
+            &c.signal,
+            &c.spectrum.freq,
+            &db[k],
+        ));
         for (peak, label) in c.peaks.iter().zip(&labels[k]) {
             p = p.with_peak(peak.freq, label);
         }

@@ -125,12 +125,47 @@ fn default_run_has_spectrum_verdict_and_pictures() {
         samples.iter().any(|&x| x.unsigned_abs() > 20_000),
         "normalised"
     );
-    // Redraw from the saved output.
+    let spec = std::fs::read_to_string(dir.join("spectrum.csv")).unwrap();
+    assert_eq!(
+        spec.lines().next().unwrap(),
+        "freq_hz,vx_d_psd,vx_d_db,vy_d_psd,vy_d_db"
+    );
+    assert_eq!(
+        spec.lines().count(),
+        1 + 16384 / 2 + 1,
+        "one row per bin of a 16384-point segment"
+    );
+    assert_eq!(s["spectrum"]["window"], "hann");
+    // Redraw from the saved output, with other analyser settings.
     for stem in ["triplet", "spectrogram", "phase"] {
         std::fs::remove_file(dir.join(format!("{stem}.png"))).unwrap();
     }
-    squeal(d.path(), &["plot", "r"]);
+    squeal(
+        d.path(),
+        &[
+            "plot",
+            "r",
+            "--window",
+            "flattop",
+            "--segment",
+            "4096",
+            "--amplitude",
+        ],
+    );
     assert!(dir.join("triplet.png").is_file() && dir.join("phase.png").is_file());
+    let spec = std::fs::read_to_string(dir.join("spectrum.csv")).unwrap();
+    assert_eq!(
+        spec.lines().next().unwrap(),
+        "freq_hz,vx_d_amp2,vx_d_db,vy_d_amp2,vy_d_db"
+    );
+    assert_eq!(spec.lines().count(), 1 + 4096 / 2 + 1);
+    let bad = Command::new(env!("CARGO_BIN_EXE_squeal"))
+        .current_dir(d.path())
+        .args(["plot", "r", "--overlap", "0.99"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--overlap 0.99"));
 }
 
 #[test]

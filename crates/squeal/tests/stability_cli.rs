@@ -150,3 +150,31 @@ fn transient_map_classifies_by_simulation() {
         }
     }
 }
+
+#[test]
+fn hoffmann_critical_friction_matches_the_coalescence() {
+    let d = tempfile::tempdir().unwrap();
+    // Undamped: the two frequencies coalesce at μ_c = ((k11 − k22)² + 4 k12²)/(4 k12 k3)
+    // with the built-in's k11 = 1e4, k12 = 2e3, k22 = 1.2e4, k3 = 1e4: μ_c = 0.25.
+    let j = json(&squeal(
+        d.path(),
+        &[
+            "critical",
+            "hoffmann",
+            "--param",
+            "mu=0.01:1",
+            "--set",
+            "c1=0",
+            "--set",
+            "c2=0",
+            "--json",
+        ],
+    ));
+    let want = ((1e4f64 - 1.2e4).powi(2) + 4.0 * 2e3f64.powi(2)) / (4.0 * 2e3 * 1e4);
+    let got = j["value"].as_f64().unwrap();
+    assert!((got - want).abs() <= 1e-9 * want, "{got} vs {want}");
+    assert_eq!(j["from_neutral"], true);
+    // The built-in is above it: it flutters.
+    let s = json(&squeal(d.path(), &["stability", "hoffmann", "--json"]));
+    assert_eq!(s["stable"], false);
+}

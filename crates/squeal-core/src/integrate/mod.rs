@@ -745,10 +745,19 @@ pub fn simulate<M: Model<N>, S: Sink<N>, const N: usize>(
     k += 1;
     while let Some(seg) = solver.step()? {
         loop {
-            let ts = t0 + k as f64 * dt;
-            if ts > seg.t1 || ts > t_end {
+            // k/rate, not k·dt: exact for every representable sample time, so the
+            // sample at t_end is not lost to round-off (0.03 s at 10 kHz is k = 300).
+            let ts = t0 + k as f64 / sample_rate;
+            // The last segment also takes a sample a hair past t_end (round-off).
+            let limit = if seg.t1 >= t_end {
+                t_end + 1e-9 * dt
+            } else {
+                seg.t1
+            };
+            if ts > limit {
                 break;
             }
+            let ts = ts.min(seg.t1);
             let z = solver.dense_at(ts);
             k += 1;
             if sink.sample(ts, &z, seg.mode) == Flow::Stop {

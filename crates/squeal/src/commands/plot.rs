@@ -12,10 +12,13 @@ use std::path::PathBuf;
 pub struct PlotArgs {
     /// A folder written by `squeal simulate`.
     run_dir: PathBuf,
+    #[command(flatten)]
+    spectrum: crate::commands::simulate::SpectrumArgs,
 }
 
 /// Run the command.
 pub fn run(a: PlotArgs) -> Result<(), RunError> {
+    let settings = a.spectrum.settings()?;
     let (run, summary) = output::read_run_dir(&a.run_dir)?;
     let model = summary["scenario"]["model"].as_str().unwrap_or("disc-pad");
     let name = summary["scenario"]["name"]
@@ -23,8 +26,9 @@ pub fn run(a: PlotArgs) -> Result<(), RunError> {
         .unwrap_or("run")
         .to_string();
     let channels = channels_for(model);
-    let an = analysis::analyse(&run, &channels);
+    let an = analysis::analyse(&run, &channels, &settings);
     analysis::draw(&run, &an, &channels, &name, &a.run_dir)?;
+    analysis::write_spectrum_csv(&an, &a.run_dir.join("spectrum.csv"))?;
     println!(
         "pictures redrawn in {} (triplet, spectrogram, phase; PNG and SVG)",
         a.run_dir.display()

@@ -32,6 +32,37 @@ pub struct SimulateArgs {
     /// Skip the pictures (triplet, spectrogram, phase portrait).
     #[arg(long)]
     no_plots: bool,
+    #[command(flatten)]
+    spectrum: SpectrumArgs,
+}
+
+/// The spectral analyser's flags, shared by `simulate` and `plot`.
+#[derive(Args, Debug, Clone)]
+pub struct SpectrumArgs {
+    /// Window of the Welch segments: hann, flattop or rect.
+    #[arg(long, default_value = "hann")]
+    window: String,
+    /// Segment (FFT) length in samples; the resolution is sample_rate / segment.
+    #[arg(long, default_value_t = crate::analysis::SEGMENT)]
+    segment: usize,
+    /// Overlap of consecutive segments (0 to 0.95).
+    #[arg(long, default_value_t = 0.5)]
+    overlap: f64,
+    /// Peak-amplitude spectrum instead of the power spectral density.
+    #[arg(long)]
+    amplitude: bool,
+}
+
+impl SpectrumArgs {
+    /// Checked settings.
+    pub fn settings(&self) -> Result<analysis::SpectrumSettings, InputError> {
+        analysis::SpectrumSettings::from_flags(
+            &self.window,
+            self.segment,
+            self.overlap,
+            self.amplitude,
+        )
+    }
 }
 
 /// Resolve the scenario named on the command line, with its overrides.
@@ -49,6 +80,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
             .map_err(|e| InputError(format!("--duration: {}", e.0)))?;
         sc.validate()?;
     }
+    let spectrum_settings = a.spectrum.settings()?;
     let (mut csv, mut npy) = (false, false);
     for f in &a.format {
         match f.as_str() {
@@ -85,7 +117,8 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
     summary["columns"] = json!(run.columns);
     summary["rms"] = json!(output::tail_rms(&run, &velocity_names));
     let channels = sc.model.channels();
-    let an = analysis::analyse(&run, &channels);
+    let an = analysis::analyse(&run, &channels, &spectrum_settings);
+    analysis::write_spectrum_csv(&an, &stage.path("spectrum.csv"))?;
     summary["spectrum"] = an.spectrum_json();
     summary["growth_rate"] = an.growth_json();
     summary["verdict"] = json!(an.verdict.as_str());
