@@ -254,10 +254,19 @@ impl Analysis {
             "segments": first.map(|c| c.spectrum.segments),
             "scaling": first.map(|c| if c.spectrum.scaling == Scaling::Amplitude { "amplitude" } else { "psd" }),
             "resolution_hz": df,
-            "tangential": channel_json(&self.tangential),
-            "normal": channel_json(&self.normal),
+            "tangential": self.with_growth(channel_json(&self.tangential), &self.tangential),
+            "normal": self.with_growth(channel_json(&self.normal), &self.normal),
         })
     }
+    /// A channel's JSON with the growth rate (1/s) of its signal added.
+    fn with_growth(&self, mut v: Value, c: &Option<ChannelSpectrum>) -> Value {
+        if let (Some(c), Some(obj)) = (c, v.as_object_mut()) {
+            let g = self.growth.iter().find(|g| g.0 == c.signal).map(|g| g.1);
+            obj.insert("growth_rate".into(), json!(g));
+        }
+        v
+    }
+
     /// The `growth_rate` key of summary.json: per velocity, rate (1/s) and window (s).
     pub fn growth_json(&self) -> Value {
         let mut m = Map::new();

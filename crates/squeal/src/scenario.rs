@@ -250,6 +250,7 @@ impl Scenario {
             "friction" | "initial" | "contact" | "duration" | "sample_rate" | "name"
             | "description" => "",
             "rtol" | "atol_pos" | "atol_vel" | "h_max" => "solver",
+            k if self.atol_index(k).is_some() => "solver",
             k if self.offset_index(k).is_some() => "offsets",
             k if self.model.get(k).is_some() => "params",
             "model" => {
@@ -264,6 +265,12 @@ impl Scenario {
             }
         };
         self.apply_in(section, key, value)
+    }
+
+    /// `atol_<state>`: a per-state absolute tolerance.
+    fn atol_index(&self, key: &str) -> Option<usize> {
+        let base = key.strip_prefix("atol_")?;
+        self.model.state_names().iter().position(|n| *n == base)
     }
 
     fn offset_index(&self, key: &str) -> Option<usize> {
@@ -352,6 +359,14 @@ impl Scenario {
                 } else {
                     self.solver.atol_vel = Some(x);
                 }
+            }
+            ("solver", k) if self.atol_index(k).is_some() => {
+                let x = number(value)?;
+                if !(x.is_finite() && x > 0.0 && x < 1.0) {
+                    return err(format!("{k} = {x}: must be > 0 and < 1"));
+                }
+                let i = self.atol_index(k).unwrap_or(0);
+                self.solver.atol_state[i] = Some(x);
             }
             ("solver", "h_max") => {
                 let x = number(value)?;
@@ -451,6 +466,11 @@ impl Scenario {
                 "h_max": if self.solver.h_max.is_finite() { json!(self.solver.h_max) } else { Value::Null },
             },
         });
+        for (name, a) in self.model.state_names().iter().zip(&self.solver.atol_state) {
+            if let Some(a) = a {
+                out["solver"][format!("atol_{name}")] = json!(a);
+            }
+        }
         if let AnyModel::DiscPad(m) = &self.model {
             out["contact"] = json!(m.contact.as_str());
         }
@@ -569,6 +589,15 @@ impl Scenario {
                 "m/s, absolute tolerance of velocities",
             );
         }
+        for (name, a) in self.model.state_names().iter().zip(&self.solver.atol_state) {
+            if let Some(a) = a {
+                line(
+                    &mut t,
+                    format!("atol_{name} = {a:?}"),
+                    "absolute tolerance of this state alone",
+                );
+            }
+        }
         if self.solver.h_max.is_finite() {
             line(
                 &mut t,
@@ -651,5 +680,15 @@ mod tests {
         s.apply_overrides(&["x_p0=1e-9".into(), "initial=equilibrium".into()])
             .unwrap();
         assert_eq!(s.offsets[1], 1e-9);
+        // Per-state tolerances, and their round trip through TOML.
+        s.apply_overrides(&["atol_vx_p=1e-12".into()]).unwrap();
+        assert_eq!(s.solver.atol_state[5], Some(1e-12));
+        assert_eq!(Scenario::from_toml(&s.to_toml()).unwrap().solver, s.solver);
+        let e = s
+            .clone()
+            .apply_overrides(&["atol_vx_p=-1".into()])
+            .unwrap_err()
+            .0;
+        assert!(e.contains("atol_vx_p"), "{e}");
     }
 }

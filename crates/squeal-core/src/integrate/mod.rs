@@ -28,6 +28,9 @@ pub struct SolverOptions {
     pub atol_pos: Option<f64>,
     /// Absolute tolerance of velocity states (m/s); `None`: the model's default.
     pub atol_vel: Option<f64>,
+    /// Per-state absolute tolerances, overriding `atol_pos`/`atol_vel` for
+    /// the states that have one (index = state index; at most [`MAX_STATES`]).
+    pub atol_state: [Option<f64>; MAX_STATES],
     /// Largest step (s).
     pub h_max: f64,
     /// First step (s); `None`: chosen automatically (Hairer's rule).
@@ -49,6 +52,7 @@ impl Default for SolverOptions {
             rtol: 1e-8,
             atol_pos: None,
             atol_vel: None,
+            atol_state: [None; MAX_STATES],
             h_max: f64::INFINITY,
             h_init: None,
             max_steps: 500_000_000,
@@ -58,6 +62,9 @@ impl Default for SolverOptions {
         }
     }
 }
+
+/// Most states a per-state tolerance can be given for.
+pub const MAX_STATES: usize = 16;
 
 /// Why a run stopped before its end.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -213,7 +220,11 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
                 opts.rtol
             )));
         }
-        for (name, v) in [("atol_pos", opts.atol_pos), ("atol_vel", opts.atol_vel)] {
+        let per_state = opts.atol_state.iter().take(N).map(|a| ("atol_state", *a));
+        for (name, v) in [("atol_pos", opts.atol_pos), ("atol_vel", opts.atol_vel)]
+            .into_iter()
+            .chain(per_state)
+        {
             if let Some(v) = v {
                 if !(v > 0.0 && v.is_finite()) {
                     return Err(IntegrateError::BadOptions(format!(
@@ -236,11 +247,12 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
         let mut atol = [0.0; N];
         let half = N / 2;
         for i in 0..N {
-            atol[i] = if i < half {
+            let by_kind = if i < half {
                 opts.atol_pos.unwrap_or(DEFAULT_ATOL_POS)
             } else {
                 opts.atol_vel.unwrap_or(DEFAULT_ATOL_VEL)
             };
+            atol[i] = opts.atol_state.get(i).copied().flatten().unwrap_or(by_kind);
         }
         let mode = model.initial_mode(t0, &z0);
         let mut s = Solver {

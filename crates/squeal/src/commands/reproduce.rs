@@ -735,14 +735,16 @@ fn report_md(rs: &[SetResult], cs: &[Conclusion], scale: f64, figures: bool, wal
             dis.iter()
                 .map(|r| {
                     let l = r.linear.as_ref();
-                    let growth_time = l.filter(|l| l.max_growth > 0.0).map(|l| r.sc.duration * l.max_growth);
+                    let growth_time = l.map(|l| r.sc.duration * l.max_growth).filter(|g| g.abs() < 1.0);
                     format!(
                         "set {} (linear {}, σ_max {}, simulated {}{})",
                         r.id,
                         r.linear_word(),
                         l.map_or("n/a".into(), |l| format!("{:+.3e}", l.max_growth)),
                         r.verdict,
-                        growth_time.map_or(String::new(), |g| format!("; σ·T = {g:.2}: too little growth to see"))
+                        growth_time.map_or(String::new(), |g| {
+                            format!("; σ·T = {g:+.3}: the run is too short to see that much growth or decay")
+                        })
                     )
                 })
                 .collect::<Vec<_>>()
