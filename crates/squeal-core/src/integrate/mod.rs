@@ -438,20 +438,13 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
         y
     }
 
-    /// [`Self::combine`] over exactly `S` stages of a constant tableau row:
-    /// with `S` and the row known at compile time the loop unrolls and the
-    /// tableau's zeros vanish.
+    /// Stage `s`: its state from the earlier stages, and its slope.
     #[inline(always)]
-    fn combine_n<const S: usize>(&self, base: &[f64; N], row: &[f64; 16], h: f64) -> [f64; N] {
-        let mut y = *base;
-        for j in 0..S {
-            let a = h * row[j];
-            let kj = &self.k[j];
-            for i in 0..N {
-                y[i] += a * kj[i];
-            }
-        }
-        y
+    fn stage(&mut self, s: usize, t: f64, z: &[f64; N], mode: Mode, h: f64) {
+        let y = self.combine(z, &A[s], s, h);
+        let mut ks = [0.0; N];
+        self.rhs(t + C[s] * h, mode, &y, &mut ks);
+        self.k[s] = ks;
     }
 
     /// One RK step of size h from the current state; fills `k[0..13]`,
@@ -460,15 +453,9 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
     fn rk_step(&mut self, h: f64) -> ([f64; N], f64) {
         let (t, z, mode) = (self.t, self.z, self.mode);
         self.k[0] = self.f;
-        macro_rules! stage {
-            ($($s:literal)*) => {$(
-                let y = self.combine_n::<$s>(&z, &A[$s], h);
-                let mut ks = [0.0; N];
-                self.rhs(t + C[$s] * h, mode, &y, &mut ks);
-                self.k[$s] = ks;
-            )*};
+        for s in 1..12 {
+            self.stage(s, t, &z, mode, h);
         }
-        stage!(1 2 3 4 5 6 7 8 9 10 11);
         let z_new = self.combine(&z, &B, 12, h);
         let mut f_new = [0.0; N];
         self.rhs(t + h, mode, &z_new, &mut f_new);
@@ -496,15 +483,9 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
     #[inline]
     fn build_dense(&mut self, h: f64, z_new: &[f64; N]) {
         let (t, z, mode) = (self.t, self.z, self.mode);
-        macro_rules! stage {
-            ($($s:literal)*) => {$(
-                let y = self.combine_n::<$s>(&z, &A[$s], h);
-                let mut ks = [0.0; N];
-                self.rhs(t + C[$s] * h, mode, &y, &mut ks);
-                self.k[$s] = ks;
-            )*};
+        for s in 13..16 {
+            self.stage(s, t, &z, mode, h);
         }
-        stage!(13 14 15);
         let zero = [0.0; N];
         for r in 0..4 {
             self.dense[3 + r] = self.combine(&zero, &D[r], 16, h);

@@ -27,6 +27,20 @@ pub struct BeltParams {
     pub N: f64,
 }
 
+impl BeltParams {
+    /// The field called `key` (one place maps names to fields, for get and set).
+    fn slot(&mut self, key: &str) -> Option<&mut f64> {
+        Some(match key {
+            "m" => &mut self.m,
+            "k" => &mut self.k,
+            "c" => &mut self.c,
+            "V" => &mut self.V,
+            "N" => &mut self.N,
+            _ => return None,
+        })
+    }
+}
+
 impl Default for BeltParams {
     fn default() -> Self {
         BeltParams {
@@ -69,28 +83,17 @@ impl Parameters for Belt {
         SPECS
     }
     fn get(&self, key: &str) -> Option<f64> {
-        Some(match key {
-            "m" => self.p.m,
-            "k" => self.p.k,
-            "c" => self.p.c,
-            "V" => self.p.V,
-            "N" => self.p.N,
-            _ => return self.friction.get(key),
-        })
+        let mut p = self.p;
+        p.slot(key).map(|v| *v).or_else(|| self.friction.get(key))
     }
     fn set(&mut self, key: &str, value: f64) -> Result<(), ParamError> {
         let Some(spec) = SPECS.iter().find(|s| s.name == key) else {
             return self.friction.set(key, value);
         };
         spec.check(value)?;
-        let slot = match key {
-            "m" => &mut self.p.m,
-            "k" => &mut self.p.k,
-            "c" => &mut self.p.c,
-            "V" => &mut self.p.V,
-            _ => &mut self.p.N,
-        };
-        *slot = value;
+        if let Some(slot) = self.p.slot(key) {
+            *slot = value;
+        }
         Ok(())
     }
     fn validate(&self) -> Result<(), ParamError> {

@@ -77,6 +77,29 @@ pub struct DiscPadParams {
     pub t_ramp: f64,
 }
 
+impl DiscPadParams {
+    /// The field called `key` (one place maps names to fields, for get and set).
+    fn slot(&mut self, key: &str) -> Option<&mut f64> {
+        Some(match key {
+            "m_d" => &mut self.m_d,
+            "m_p" => &mut self.m_p,
+            "k_dx" => &mut self.k_dx,
+            "c_dx" => &mut self.c_dx,
+            "k_dy" => &mut self.k_dy,
+            "c_dy" => &mut self.c_dy,
+            "k_px" => &mut self.k_px,
+            "c_px" => &mut self.c_px,
+            "k_py" => &mut self.k_py,
+            "c_py" => &mut self.c_py,
+            "N" => &mut self.N,
+            "V" => &mut self.V,
+            "alpha" => &mut self.alpha,
+            "t_ramp" => &mut self.t_ramp,
+            _ => return None,
+        })
+    }
+}
+
 impl Default for DiscPadParams {
     fn default() -> Self {
         DiscPadParams {
@@ -274,24 +297,8 @@ impl Parameters for DiscPad {
     }
 
     fn get(&self, key: &str) -> Option<f64> {
-        let p = &self.p;
-        Some(match key {
-            "m_d" => p.m_d,
-            "m_p" => p.m_p,
-            "k_dx" => p.k_dx,
-            "c_dx" => p.c_dx,
-            "k_dy" => p.k_dy,
-            "c_dy" => p.c_dy,
-            "k_px" => p.k_px,
-            "c_px" => p.c_px,
-            "k_py" => p.k_py,
-            "c_py" => p.c_py,
-            "N" => p.N,
-            "V" => p.V,
-            "alpha" => p.alpha,
-            "t_ramp" => p.t_ramp,
-            _ => return self.friction.get(key),
-        })
+        let mut p = self.p;
+        p.slot(key).map(|v| *v).or_else(|| self.friction.get(key))
     }
 
     fn set(&mut self, key: &str, value: f64) -> Result<(), ParamError> {
@@ -299,24 +306,9 @@ impl Parameters for DiscPad {
             return self.friction.set(key, value);
         };
         spec.check(value)?;
-        let p = &mut self.p;
-        let slot = match key {
-            "m_d" => &mut p.m_d,
-            "m_p" => &mut p.m_p,
-            "k_dx" => &mut p.k_dx,
-            "c_dx" => &mut p.c_dx,
-            "k_dy" => &mut p.k_dy,
-            "c_dy" => &mut p.c_dy,
-            "k_px" => &mut p.k_px,
-            "c_px" => &mut p.c_px,
-            "k_py" => &mut p.k_py,
-            "c_py" => &mut p.c_py,
-            "N" => &mut p.N,
-            "V" => &mut p.V,
-            "alpha" => &mut p.alpha,
-            _ => &mut p.t_ramp,
-        };
-        *slot = value;
+        if let Some(slot) = self.p.slot(key) {
+            *slot = value;
+        }
         Ok(())
     }
 

@@ -64,6 +64,24 @@ pub struct HoffmannParams {
     pub N0: f64,
 }
 
+impl HoffmannParams {
+    /// The field called `key` (one place maps names to fields, for get and set).
+    fn slot(&mut self, key: &str) -> Option<&mut f64> {
+        Some(match key {
+            "m" => &mut self.m,
+            "c1" => &mut self.c1,
+            "c2" => &mut self.c2,
+            "k11" => &mut self.k11,
+            "k12" => &mut self.k12,
+            "k22" => &mut self.k22,
+            "k3" => &mut self.k3,
+            "V" => &mut self.V,
+            "N0" => &mut self.N0,
+            _ => return None,
+        })
+    }
+}
+
 impl Default for HoffmannParams {
     /// m = 1 kg, c1 = c2 = 0.5 kg/s, k11 = 1e4, k12 = 2e3, k22 = 1.2e4,
     /// k3 = 1e4 N/m, V = 1 m/s, N0 = 100 N: frequencies 14.8 and 18.3 Hz at
@@ -186,23 +204,14 @@ impl Parameters for Hoffmann {
 
     /// `mu` is μ of the Coulomb law (`mu_k`); `None` for other laws.
     fn get(&self, key: &str) -> Option<f64> {
-        let p = &self.p;
-        Some(match key {
-            "m" => p.m,
-            "c1" => p.c1,
-            "c2" => p.c2,
-            "k11" => p.k11,
-            "k12" => p.k12,
-            "k22" => p.k22,
-            "k3" => p.k3,
-            "V" => p.V,
-            "N0" => p.N0,
-            "mu" => match self.friction {
-                FrictionLaw::Coulomb { mu_k, .. } => mu_k,
-                _ => return None,
-            },
-            _ => return self.friction.get(key),
-        })
+        if key == "mu" {
+            return match self.friction {
+                FrictionLaw::Coulomb { mu_k, .. } => Some(mu_k),
+                _ => None,
+            };
+        }
+        let mut p = self.p;
+        p.slot(key).map(|v| *v).or_else(|| self.friction.get(key))
     }
 
     /// `mu` sets both `mu_s` and `mu_k` of the Coulomb law; with another law
@@ -212,37 +221,25 @@ impl Parameters for Hoffmann {
             return self.friction.set(key, value);
         };
         spec.check(value)?;
-        let p = &mut self.p;
-        let slot = match key {
-            "m" => &mut p.m,
-            "c1" => &mut p.c1,
-            "c2" => &mut p.c2,
-            "k11" => &mut p.k11,
-            "k12" => &mut p.k12,
-            "k22" => &mut p.k22,
-            "k3" => &mut p.k3,
-            "V" => &mut p.V,
-            "N0" => &mut p.N0,
-            _ => {
-                return match &mut self.friction {
-                    FrictionLaw::Coulomb { mu_s, mu_k } => {
-                        *mu_s = value;
-                        *mu_k = value;
-                        Ok(())
-                    }
-                    other => Err(ParamError::Invalid {
-                        key: key.into(),
-                        value,
-                        why: format!(
-                            "mu applies to the coulomb friction law; the law is '{}', set its own parameters",
-                            other.name()
-                        ),
-                    }),
-                };
+        if let Some(slot) = self.p.slot(key) {
+            *slot = value;
+            return Ok(());
+        }
+        match &mut self.friction {
+            FrictionLaw::Coulomb { mu_s, mu_k } => {
+                *mu_s = value;
+                *mu_k = value;
+                Ok(())
             }
-        };
-        *slot = value;
-        Ok(())
+            other => Err(ParamError::Invalid {
+                key: key.into(),
+                value,
+                why: format!(
+                    "mu applies to the coulomb friction law; the law is '{}', set its own parameters",
+                    other.name()
+                ),
+            }),
+        }
     }
 
     fn validate(&self) -> Result<(), ParamError> {
