@@ -278,6 +278,11 @@ struct Conclusion {
     evidence: String,
 }
 
+/// The sets of `v` for which `keep` holds.
+fn pick<'a>(v: &[&'a SetResult], keep: impl Fn(&SetResult) -> bool) -> Vec<&'a SetResult> {
+    v.iter().copied().filter(|r| keep(r)).collect()
+}
+
 fn ids(v: &[&SetResult]) -> String {
     let list: Vec<String> = v.iter().map(|r| r.id.to_string()).collect();
     if list.is_empty() {
@@ -379,26 +384,16 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
     let mut out = Vec::new();
 
     // 1. Stribeck effect.
-    let no_stribeck: Vec<&SetResult> = sliding
-        .iter()
-        .copied()
-        .filter(|r| r.p("f1") == 0.0)
-        .collect();
-    let bad: Vec<&SetResult> = no_stribeck
-        .iter()
-        .copied()
-        .filter(|r| r.linear.as_ref().is_some_and(|l| l.growing) || squeals(r))
-        .collect();
-    let with: Vec<&SetResult> = sliding
-        .iter()
-        .copied()
-        .filter(|r| {
-            r.p("f1") > 0.0
-                && r.p("V") < uc
-                && r.linear.as_ref().is_some_and(|l| l.growing)
-                && squeals(r)
-        })
-        .collect();
+    let no_stribeck: Vec<&SetResult> = pick(&sliding, |r| r.p("f1") == 0.0);
+    let bad: Vec<&SetResult> = pick(&no_stribeck, |r| {
+        r.linear.as_ref().is_some_and(|l| l.growing) || squeals(r)
+    });
+    let with: Vec<&SetResult> = pick(&sliding, |r| {
+        r.p("f1") > 0.0
+            && r.p("V") < uc
+            && r.linear.as_ref().is_some_and(|l| l.growing)
+            && squeals(r)
+    });
     let worst = no_stribeck
         .iter()
         .filter_map(|r| r.linear.as_ref().map(|l| (l.max_growth, r.id)))
@@ -415,21 +410,9 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
     });
 
     // 2. Normal → tangential spectrum, not the reverse.
-    let a0: Vec<&SetResult> = sliding
-        .iter()
-        .copied()
-        .filter(|r| r.p("alpha") == 0.0)
-        .collect();
-    let present: Vec<&SetResult> = a0
-        .iter()
-        .copied()
-        .filter(|r| r.tan_prom_at_fn.is_some_and(|p| p >= 10.0))
-        .collect();
-    let leak: Vec<&SetResult> = a0
-        .iter()
-        .copied()
-        .filter(|r| r.nor_prom_at_ft.is_some_and(|p| p > 3.0))
-        .collect();
+    let a0: Vec<&SetResult> = pick(&sliding, |r| r.p("alpha") == 0.0);
+    let present: Vec<&SetResult> = pick(&a0, |r| r.tan_prom_at_fn.is_some_and(|p| p >= 10.0));
+    let leak: Vec<&SetResult> = pick(&a0, |r| r.nor_prom_at_ft.is_some_and(|p| p > 3.0));
     let minmax = |f: &dyn Fn(&SetResult) -> Option<f64>| {
         let v: Vec<f64> = a0.iter().filter_map(|r| f(r)).collect();
         (
@@ -451,12 +434,10 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
     });
 
     // 3. Nothing grows above Uc.
-    let above: Vec<&SetResult> = sliding.iter().copied().filter(|r| r.p("V") > uc).collect();
-    let above_bad: Vec<&SetResult> = above
-        .iter()
-        .copied()
-        .filter(|r| squeals(r) || r.linear.as_ref().is_some_and(|l| l.growing))
-        .collect();
+    let above: Vec<&SetResult> = pick(&sliding, |r| r.p("V") > uc);
+    let above_bad: Vec<&SetResult> = pick(&above, |r| {
+        squeals(r) || r.linear.as_ref().is_some_and(|l| l.growing)
+    });
     let (npts, smax, sv, sn) = sw.above_uc;
     out.push(Conclusion {
         id: 3,
@@ -493,27 +474,16 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
     });
 
     // 5. Stick-slip bounds the growth.
-    let unstable: Vec<&SetResult> = sliding
-        .iter()
-        .copied()
-        .filter(|r| r.linear.as_ref().is_some_and(|l| l.growing))
-        .collect();
+    let unstable: Vec<&SetResult> =
+        pick(&sliding, |r| r.linear.as_ref().is_some_and(|l| l.growing));
     // The Stribeck-driven growth of the thesis: no follower force, and the first
     // reversal early enough (before 60 % of the run) for the cycle to settle.
-    let saturated: Vec<&SetResult> = unstable
-        .iter()
-        .copied()
-        .filter(|r| {
-            r.p("alpha") == 0.0 && r.first_reversal.is_some_and(|t| t < 0.6 * r.sc.duration)
-        })
-        .collect();
-    let late: Vec<&SetResult> = unstable
-        .iter()
-        .copied()
-        .filter(|r| {
-            r.p("alpha") == 0.0 && r.first_reversal.is_some_and(|t| t >= 0.6 * r.sc.duration)
-        })
-        .collect();
+    let saturated: Vec<&SetResult> = pick(&unstable, |r| {
+        r.p("alpha") == 0.0 && r.first_reversal.is_some_and(|t| t < 0.6 * r.sc.duration)
+    });
+    let late: Vec<&SetResult> = pick(&unstable, |r| {
+        r.p("alpha") == 0.0 && r.first_reversal.is_some_and(|t| t >= 0.6 * r.sc.duration)
+    });
     let follower: Vec<String> = unstable
         .iter()
         .filter(|r| r.p("alpha") != 0.0)
@@ -526,16 +496,10 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
             )
         })
         .collect();
-    let bounded: Vec<&SetResult> = saturated
-        .iter()
-        .copied()
-        .filter(|r| r.verdict == "stick-slip" && r.vxp_max <= 2.0 * r.p("V"))
-        .collect();
-    let unsat: Vec<&SetResult> = unstable
-        .iter()
-        .copied()
-        .filter(|r| r.first_reversal.is_none())
-        .collect();
+    let bounded: Vec<&SetResult> = pick(&saturated, |r| {
+        r.verdict == "stick-slip" && r.vxp_max <= 2.0 * r.p("V")
+    });
+    let unsat: Vec<&SetResult> = pick(&unstable, |r| r.first_reversal.is_none());
     let ratio = saturated
         .iter()
         .map(|r| r.vxp_max / r.p("V"))
