@@ -335,16 +335,13 @@ pub fn draw(
     let mut panels = Vec::new();
     if let Some(x) = run.column(ch.tangential) {
         panels.push(
-            Panel::new(&tan_title, "time (s)", "velocity (m/s)").with_series(Series::new(
-                ch.tangential,
-                t,
-                x,
-            )),
+            // One series per panel, named in its title: no legend to cover the data.
+            Panel::new(&tan_title, "time (s)", "velocity (m/s)").with_series(Series::new("", t, x)),
         );
     }
-    if let Some((n, x)) = ch.normal.and_then(|n| run.column(n).map(|x| (n, x))) {
+    if let Some(x) = ch.normal.and_then(|n| run.column(n)) {
         panels.push(
-            Panel::new(&nor_title, "time (s)", "velocity (m/s)").with_series(Series::new(n, t, x)),
+            Panel::new(&nor_title, "time (s)", "velocity (m/s)").with_series(Series::new("", t, x)),
         );
     }
     let chans: Vec<(&ChannelSpectrum, &str)> =
@@ -385,7 +382,7 @@ pub fn draw(
             "PSD (dB re 1 (m/s)²/Hz)"
         };
         let mut p = Panel::new(&titles[k], "frequency (Hz)", y_label).with_series(Series::new(
-            &c.signal,
+            "",
             &c.spectrum.freq,
             &db[k],
         ));
