@@ -17,6 +17,10 @@ use squeal_signal::{
 use std::fmt::Write as _;
 use std::path::Path;
 
+/// Velocities below this (m/s) everywhere in a run are integration noise
+/// around an equilibrium, not motion to classify.
+pub const STILL: f64 = 1e-9;
+
 /// Longest Welch segment (samples): 16384 at 200 kHz resolves 12.2 Hz.
 pub const SEGMENT: usize = 16384;
 
@@ -170,7 +174,9 @@ pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
         }
     }
     // The verdict is about the friction-excited (tangential) motion; only when
-    // there is none (a disc at rest) does it describe the normal motion. A
+    // there is none (a disc at rest) does it describe the normal motion; when
+    // nothing moves by more than STILL (a run started exactly at a stable
+    // equilibrium, where only integration noise remains) it decays. A
     // steady tail is one whose level changes by less than 0.25 dB: slow decays
     // (the disc's ≈ 0.5 1/s) must not pass for limit cycles.
     let opts = VerdictOptions {
@@ -179,7 +185,7 @@ pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
     };
     let moving = |name: &str| {
         run.column(name)
-            .is_some_and(|x| x.iter().any(|v| *v != 0.0))
+            .is_some_and(|x| x.iter().any(|v| v.abs() > STILL))
     };
     let velocity = |name: &str| name.starts_with('v') && name != "v_rel";
     let tangential_cols: Vec<&String> = run
