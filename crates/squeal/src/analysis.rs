@@ -17,9 +17,10 @@ use squeal_signal::{
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Velocities below this (m/s) everywhere in a run are integration noise
-/// around an equilibrium, not motion to classify.
-pub const STILL: f64 = 1e-9;
+/// Velocities below this fraction of the sliding speed (or of 1 mm/s when
+/// the run does not slide) everywhere in a run are integration noise around
+/// an equilibrium, not motion to classify.
+pub const STILL: f64 = 1e-8;
 
 /// Longest Welch segment (samples): 16384 at 200 kHz resolves 12.2 Hz.
 pub const SEGMENT: usize = 16384;
@@ -175,7 +176,7 @@ pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
     }
     // The verdict is about the friction-excited (tangential) motion; only when
     // there is none (a disc at rest) does it describe the normal motion; when
-    // nothing moves by more than STILL (a run started exactly at a stable
+    // nothing moves by more than STILL·V (a run started exactly at a stable
     // equilibrium, where only integration noise remains) it decays. A
     // steady tail is one whose level changes by less than 0.25 dB: slow decays
     // (the disc's ≈ 0.5 1/s) must not pass for limit cycles.
@@ -183,9 +184,11 @@ pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
         steady_tol_db: 0.25,
         ..VerdictOptions::default()
     };
+    let speed = run.column("v_rel").map_or(0.0, |v| v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+    let still = STILL * speed.max(1e-3);
     let moving = |name: &str| {
         run.column(name)
-            .is_some_and(|x| x.iter().any(|v| v.abs() > STILL))
+            .is_some_and(|x| x.iter().any(|v| v.abs() > still))
     };
     let velocity = |name: &str| name.starts_with('v') && name != "v_rel";
     let tangential_cols: Vec<&String> = run
