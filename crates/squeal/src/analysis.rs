@@ -184,7 +184,9 @@ pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
         steady_tol_db: 0.25,
         ..VerdictOptions::default()
     };
-    let speed = run.column("v_rel").map_or(0.0, |v| v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+    let speed = run
+        .column("v_rel")
+        .map_or(0.0, |v| v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
     let still = STILL * speed.max(1e-3);
     let moving = |name: &str| {
         run.column(name)

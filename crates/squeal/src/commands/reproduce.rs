@@ -708,7 +708,14 @@ fn report_md(rs: &[SetResult], cs: &[Conclusion], scale: f64, figures: bool, wal
                         r.verdict,
                         growth_time.map_or(String::new(), |g| {
                             format!("; σ·T = {g:+.3}: the run is too short to see that much growth or decay")
-                        })
+                        }) + &{
+                            let sep = r.events[EventKind::Separate.index()];
+                            if sep > 0 {
+                                format!("; the pad lifts off the disc {sep} times: contact loss, which the linearisation about steady sliding cannot see, decides the outcome")
+                            } else {
+                                String::new()
+                            }
+                        }
                     )
                 })
                 .collect::<Vec<_>>()
