@@ -36,7 +36,7 @@ pub struct ScenarioArgs {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Integrate a scenario and write series.csv, events.csv and summary.json.
+    /// Integrate a scenario; write series, events, spectra, summary.json and pictures (and sound).
     Simulate(commands::simulate::SimulateArgs),
     /// Eigen-analysis of steady sliding: every mode's growth rate, frequency, damping.
     Stability(commands::stability::StabilityArgs),

@@ -128,7 +128,18 @@ impl Scenario {
         if path.is_file() || spec.ends_with(".toml") {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| InputError(format!("scenario file {spec}: cannot read: {e}")))?;
-            return Scenario::from_toml(&text).map_err(|e| InputError(format!("{spec}: {}", e.0)));
+            let mut sc =
+                Scenario::from_toml(&text).map_err(|e| InputError(format!("{spec}: {}", e.0)))?;
+            // A file without a `name` is named after itself (out/<file stem>).
+            let named = text
+                .parse::<toml::Table>()
+                .is_ok_and(|t| t.contains_key("name"));
+            if !named {
+                if let Some(stem) = path.file_stem() {
+                    sc.name = stem.to_string_lossy().into_owned();
+                }
+            }
+            return Ok(sc);
         }
         Scenario::builtin(spec).ok_or_else(|| {
             InputError(format!(
