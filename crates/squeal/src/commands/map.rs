@@ -318,6 +318,25 @@ pub fn transient_grid(
         .collect()
 }
 
+/// Do the linear verdict (σ) and the simulated outcome tell the same story?
+/// `yes`, `no`, or empty where either is missing.
+fn agree(sigma: f64, o: &Outcome) -> &'static str {
+    if !sigma.is_finite() || o.class == "failed" {
+        return "";
+    }
+    let unstable = sigma > 0.0;
+    let grew = matches!(o.class, "grows" | "stick-slip");
+    let decayed = o.class == "decays";
+    if (unstable && grew) || (!unstable && decayed) {
+        "yes"
+    } else if (unstable && decayed) || (!unstable && grew) {
+        "no"
+    } else {
+        // "steady": neutral, or too slow to tell within the run.
+        ""
+    }
+}
+
 fn num(x: f64) -> String {
     if x.is_finite() {
         format!("{x:e}")
@@ -363,7 +382,7 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
     let mut w = std::io::BufWriter::new(std::fs::File::create(&path).map_err(io)?);
     let mut header = format!("{},{},max_growth_rate,freq_hz", x.name, y.name);
     if trans.is_some() {
-        header.push_str(",outcome,rms_tangential,stick_fraction,t_end");
+        header.push_str(",outcome,rms_tangential,stick_fraction,t_end,agree");
     }
     writeln!(w, "{header}").map_err(io)?;
     let nx = x.values.len();
@@ -382,11 +401,12 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
             let o = &t[k];
             write!(
                 w,
-                ",{},{},{},{}",
+                ",{},{},{},{},{}",
                 o.class,
                 num(o.rms),
                 num(o.stick_fraction),
-                num(o.t_end)
+                num(o.t_end),
+                agree(*s, o)
             )
             .map_err(io)?;
         }
@@ -455,9 +475,7 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
         disagree = t
             .iter()
             .zip(&lin)
-            .filter(|(o, (s, _))| {
-                (*s > 0.0) == (o.class == "decays") && s.is_finite() && o.class != "failed"
-            })
+            .filter(|(o, (s, _))| agree(*s, o) == "no")
             .count();
     }
     let dest = stage.commit()?;
