@@ -482,7 +482,13 @@ pub fn write_wav(
     path: &Path,
     float: bool,
 ) -> Result<squeal_signal::AudioClip, RunError> {
-    let clip = squeal_signal::render_audio(x, fs, &squeal_signal::AudioOptions::default())
+    // Loop the last fifth: the part the verdict judges steady (the last half of
+    // a squeal run often still holds its growth or the pad's saturation).
+    let opts = squeal_signal::AudioOptions {
+        loop_fraction: 0.2,
+        ..squeal_signal::AudioOptions::default()
+    };
+    let clip = squeal_signal::render_audio(x, fs, &opts)
         .map_err(|e| RunError::Io(format!("audio rendering failed: {e}")))?;
     let spec = hound::WavSpec {
         channels: 1,
