@@ -235,8 +235,12 @@ pub trait Model<const N: usize>: Sync {
     fn next_breakpoint(&self, _t: f64) -> Option<f64> {
         None
     }
-    /// The steady-sliding equilibrium (all velocities zero, v = V).
-    fn equilibrium(&self) -> Result<[f64; N], ModelError>;
+    /// The steady-sliding equilibrium (all velocities zero, v = V). Models
+    /// with a closed form override this; the default solves for it by
+    /// Newton's method on the slip equations ([`newton_equilibrium`]).
+    fn equilibrium(&self) -> Result<[f64; N], ModelError> {
+        newton_equilibrium(self, &[0.0; N])
+    }
     /// Analytic Jacobian ∂f/∂z of the slip equations (mode [`Mode::SlipPos`]) at `z`.
     fn jacobian(&self, z: &[f64; N]) -> [[f64; N]; N];
 }
@@ -278,4 +282,42 @@ pub fn friction_event(from: Mode, to: Mode) -> Option<EventKind> {
         (Mode::SlipPos, Mode::SlipNeg) | (Mode::SlipNeg, Mode::SlipPos) => Some(EventKind::Reverse),
         _ => None,
     }
+}
+
+/// Steady sliding by Newton's method: positions `q` with zero velocities such
+/// that the slip accelerations (mode [`Mode::SlipPos`]) vanish, starting from
+/// the positions of `guess`. The Newton matrix is the position block of the
+/// model's analytic Jacobian; each iteration solves it by LU with partial
+/// pivoting. Converges when the update is below 1e-14 of the positions' size.
+pub fn newton_equilibrium<M: Model<N> + ?Sized, const N: usize>(
+    model: &M,
+    guess: &[f64; N],
+) -> Result<[f64; N], ModelError> {
+    let n = N / 2;
+    let mut z = [0.0; N];
+    z[..n].copy_from_slice(&guess[..n]);
+    let mut f = [0.0; N];
+    for _ in 0..100 {
+        model.rhs(f64::INFINITY, Mode::SlipPos, &z, &mut f);
+        let j = model.jacobian(&z);
+        let a = nalgebra::DMatrix::from_fn(n, n, |r, c| j[n + r][c]);
+        let b = nalgebra::DVector::from_fn(n, |r, _| -f[n + r]);
+        let dq = a.lu().solve(&b).ok_or_else(|| {
+            ModelError::NoSteadySliding("the steady-sliding equations are singular".into())
+        })?;
+        let size = z[..n].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let step = dq.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for r in 0..n {
+            z[r] += dq[r];
+        }
+        if !step.is_finite() {
+            break;
+        }
+        if step <= 1e-14 * size.max(f64::MIN_POSITIVE) || step == 0.0 {
+            return Ok(z);
+        }
+    }
+    Err(ModelError::NoSteadySliding(
+        "Newton's method did not converge on the steady-sliding state".into(),
+    ))
 }
