@@ -946,6 +946,7 @@ fn draw_map(rs: &[SetResult], dir: &Path) -> Result<(), RunError> {
         colormap: Colormap::Diverging,
         contour_zero: true,
         markers: &markers,
+        value_range: crate::commands::map::robust_range(&vals),
         nan_label: "no steady sliding",
         ..HeatmapSpec::new(
             "Stability of steady sliding (default damping) with the thesis's sets",
