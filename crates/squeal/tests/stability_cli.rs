@@ -178,3 +178,46 @@ fn hoffmann_critical_friction_matches_the_coalescence() {
     let s = json(&squeal(d.path(), &["stability", "hoffmann", "--json"]));
     assert_eq!(s["stable"], false);
 }
+
+#[test]
+fn map_and_critical_refuse_bad_ranges_with_exit_code_2() {
+    let d = tempfile::tempdir().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["map", "--x", "Q=0:1:10", "--y", "N=1:2:3", "--out", "m"],
+            "Q",
+        ),
+        (
+            &["map", "--x", "V=2:1:10", "--y", "N=1:2:3", "--out", "m"],
+            "V=2:1:10",
+        ),
+        (
+            &["map", "--x", "V=1:2:1", "--y", "N=1:2:3", "--out", "m"],
+            "V=1:2:1",
+        ),
+        (
+            &[
+                "map", "--x", "V=0:2:5", "--y", "N=1:2:3", "--log-x", "--out", "m",
+            ],
+            "LO > 0",
+        ),
+        (
+            &["map", "--x", "V=1:2:5", "--y", "V=1:2:3", "--out", "m"],
+            "both vary V",
+        ),
+        (
+            &["map", "--x", "V=1:2", "--y", "N=1:2:3", "--out", "m"],
+            "NAME=LO:HI:N",
+        ),
+        (&["critical", "--param", "V=3:1"], "V=3:1"),
+        (&["critical", "--param", "V"], "NAME=LO:HI"),
+    ];
+    for (args, needle) in cases {
+        let out = squeal_env(d.path(), args, &[]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: '{needle}' not in {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(!d.path().join("m").exists());
+    }
+}
