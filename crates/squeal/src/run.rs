@@ -107,20 +107,28 @@ pub fn progress_bar(len: u64, what: &str) -> ProgressBar {
     pb
 }
 
+/// The scenario's initial state (`rest` or `equilibrium`, plus its offsets).
+pub fn initial_of<M: Model<N>, const N: usize>(
+    model: &M,
+    sc: &Scenario,
+) -> Result<[f64; N], RunError> {
+    let mut offsets = [0.0; N];
+    offsets.copy_from_slice(&sc.offsets);
+    initial_state(model, sc.initial, &offsets).map_err(|e| {
+        RunError::Input(InputError(format!(
+            "initial = {}: {e}",
+            sc.initial.as_str()
+        )))
+    })
+}
+
 fn run_model<M: Model<N>, const N: usize>(
     model: &M,
     any: &AnyModel,
     sc: &Scenario,
     progress: &ProgressBar,
 ) -> Result<Run, RunError> {
-    let mut offsets = [0.0; N];
-    offsets.copy_from_slice(&sc.offsets);
-    let z0 = initial_state(model, sc.initial, &offsets).map_err(|e| {
-        RunError::Input(InputError(format!(
-            "initial = {}: {e}",
-            sc.initial.as_str()
-        )))
-    })?;
+    let z0 = initial_of(model, sc)?;
     let mut columns = vec!["t".to_string()];
     columns.extend(model.state_names().iter().map(|s| s.to_string()));
     columns.extend(any.derived_columns().iter().map(|s| s.to_string()));

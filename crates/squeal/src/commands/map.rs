@@ -11,7 +11,6 @@ use crate::ScenarioArgs;
 use clap::Args;
 use rayon::prelude::*;
 use serde_json::json;
-use squeal_core::initial::initial_state;
 use squeal_core::integrate::{Flow, Sink};
 use squeal_core::{simulate, EventKind, Mode, Model};
 use squeal_plot::{Colormap, Format, HeatmapSpec};
@@ -231,9 +230,7 @@ fn transient_point<M: Model<N>, const N: usize>(
         .filter(|&i| names[i].starts_with("vx") || names[i] == "v")
         .collect();
     let v_idx = *idx.first().ok_or("no tangential velocity")?;
-    let mut offsets = [0.0; N];
-    offsets.copy_from_slice(&sc.offsets);
-    let z0 = initial_state(model, sc.initial, &offsets).map_err(|e| e.to_string())?;
+    let z0 = crate::run::initial_of(model, sc).map_err(|e| e.to_string())?;
     let window = sc.duration / 50.0;
     let mut w = Watch {
         idx,
@@ -250,8 +247,8 @@ fn transient_point<M: Model<N>, const N: usize>(
         peak: 0.0,
         decided: None,
     };
-    // Sample often enough to see each window's peak (≥ 20 samples per fastest cycle is not
-    // needed for a class: the window maximum of a 200 kHz series is within a few % of the envelope).
+    // Each window's peak is taken over the scenario's samples: at 200 kHz it is
+    // within a few % of the envelope, which is all a class needs.
     let info = simulate(
         model,
         0.0,
