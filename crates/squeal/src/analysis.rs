@@ -442,7 +442,10 @@ pub fn draw(
         let from = x.len() - x.len() / 5;
         let (x, v) = (&x[from..], &v[from..]);
         let t_from = t.get(from).copied().unwrap_or(0.0);
-        let title = format!("{title}: pad tangential phase portrait, t ≥ {t_from:.3} s");
+        let title = format!(
+            "{title}: phase portrait {} – {}, t ≥ {t_from:.3} s",
+            ch.phase.0, ch.phase.1
+        );
         let x_label = format!("{} (m)", ch.phase.0);
         let y_label = format!("{} (m/s)", ch.phase.1);
         let labels = Labels {
