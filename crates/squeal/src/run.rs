@@ -187,9 +187,43 @@ pub struct Staging {
     done: bool,
 }
 
+/// Files by which an existing folder is recognised as squeal's own output.
+const MARKERS: [&str; 4] = ["summary.json", "map.csv", "report.md", "conclusions.json"];
+
+/// Check, before any work, that `dest` may be written: it does not exist, or
+/// it is an empty folder, or a folder squeal wrote before (which is replaced).
+/// Anything else — a file, the current folder, a folder of the user's — is
+/// refused rather than replaced.
+pub fn check_dest(dest: &Path) -> Result<(), RunError> {
+    let refuse =
+        |why: &str| RunError::Input(InputError(format!("--out {}: {why}", dest.display())));
+    if dest.file_name().is_none() {
+        return Err(refuse(
+            "name a folder of its own (squeal replaces it whole)",
+        ));
+    }
+    if !dest.exists() {
+        return Ok(());
+    }
+    if !dest.is_dir() {
+        return Err(refuse("exists and is not a folder"));
+    }
+    let mut entries =
+        std::fs::read_dir(dest).map_err(|e| refuse(&format!("cannot read it: {e}")))?;
+    let empty = entries.next().is_none();
+    if empty || MARKERS.iter().any(|m| dest.join(m).is_file()) {
+        Ok(())
+    } else {
+        Err(refuse(
+            "exists and is not a squeal output folder; refusing to replace it",
+        ))
+    }
+}
+
 impl Staging {
-    /// Stage output for `dest`.
+    /// Stage output for `dest` (checked by [`check_dest`]).
     pub fn new(dest: &Path) -> Result<Staging, RunError> {
+        check_dest(dest)?;
         let io = |e: std::io::Error, p: &Path| {
             RunError::Io(format!("cannot create {}: {e}", p.display()))
         };

@@ -323,3 +323,36 @@ fn overrides_reach_the_run() {
     assert_eq!(sc["friction"]["mu_k"], 0.05);
     assert_eq!(sc["friction"]["mu_s"], 0.1);
 }
+
+/// `--out` never replaces what squeal did not write.
+#[test]
+fn output_folder_guards_user_data() {
+    let d = tmp();
+    std::fs::create_dir(d.path().join("mine")).unwrap();
+    std::fs::write(d.path().join("mine/thesis.tex"), "precious").unwrap();
+    std::fs::write(d.path().join("afile"), "precious").unwrap();
+    for out in ["mine", "afile", "."] {
+        let o = squeal(d.path(), &["simulate", "--duration", "0.001", "--out", out]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "--out {out}: {err}");
+        assert!(err.contains("--out"), "{err}");
+    }
+    assert_eq!(
+        std::fs::read_to_string(d.path().join("mine/thesis.tex")).unwrap(),
+        "precious"
+    );
+    assert_eq!(
+        std::fs::read_to_string(d.path().join("afile")).unwrap(),
+        "precious"
+    );
+    // A folder squeal wrote is replaced whole by the next run.
+    for dur in ["0.002", "0.001"] {
+        let o = squeal(
+            d.path(),
+            &["simulate", "--duration", dur, "--out", "run", "--no-plots"],
+        );
+        assert!(o.status.success());
+    }
+    let series = read(d.path().join("run/series.csv"));
+    assert_eq!(series.lines().count(), 1 + 201);
+}

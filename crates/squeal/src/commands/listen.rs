@@ -26,6 +26,13 @@ pub struct ListenArgs {
 
 /// Run the command.
 pub fn run(a: ListenArgs) -> Result<(), RunError> {
+    if a.out.is_dir() {
+        return Err(InputError(format!(
+            "--out {}: is a folder; name a .wav file",
+            a.out.display()
+        ))
+        .into());
+    }
     let dir = Path::new(&a.scenario.scenario);
     let (run, model) = if dir.is_dir() {
         if !a.scenario.sets.is_empty() {

@@ -379,6 +379,7 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-map", sc.name)));
+    crate::run::check_dest(&dest)?;
     let n = x.values.len() * y.values.len();
     let pb = progress_bar(n as u64, "eigen-analysis");
     let lin = linear_grid(&sc.model, &x, &y, &pb);

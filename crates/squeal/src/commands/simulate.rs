@@ -95,6 +95,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
+    run::check_dest(&dest)?;
     let run = run::run(&sc)?;
     let t0 = Instant::now();
     let stage = Staging::new(&dest)?;
