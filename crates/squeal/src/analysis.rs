@@ -466,7 +466,7 @@ pub fn draw(
     Ok(())
 }
 
-/// Row-major [time][freq] → row-major [freq][time] (heatmap rows are y).
+/// Row-major (time, freq) → row-major (freq, time): heatmap rows are y.
 fn transpose(a: &[f64], n_rows: usize, n_cols: usize) -> Vec<f64> {
     let mut out = vec![0.0; a.len()];
     for r in 0..n_rows {

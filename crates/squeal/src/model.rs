@@ -4,7 +4,7 @@ use squeal_core::model::Observables;
 use squeal_core::{Belt, DiscPad, Hoffmann, Mode, Model, ParamError, ParamSpec, Parameters};
 
 /// Any model squeal can run. Adding a model: one variant here and one arm in
-/// [`with_model!`]; the integrator and the commands stay unchanged.
+/// [`with_model!`](crate::with_model); the integrator and the commands stay unchanged.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum AnyModel {
     /// The 4-DOF disc–pad model of the thesis.

@@ -34,7 +34,7 @@ pub struct MapArgs {
     /// Space the y values logarithmically.
     #[arg(long)]
     log_y: bool,
-    /// Output folder (default: out/<scenario>-map).
+    /// Output folder (default: out/SCENARIO-map).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Classify every point by simulation too (decays / grows / stick-slip / steady).

@@ -17,7 +17,7 @@ pub struct SimulateArgs {
     /// Simulated time in seconds (overrides the scenario's).
     #[arg(long, allow_negative_numbers = true)]
     duration: Option<f64>,
-    /// Output folder (default: out/<scenario name>).
+    /// Output folder (default: out/SCENARIO, the scenario's name).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Series formats, comma-separated: csv, npy.
