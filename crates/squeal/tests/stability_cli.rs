@@ -221,3 +221,40 @@ fn map_and_critical_refuse_bad_ranges_with_exit_code_2() {
         assert!(!d.path().join("m").exists());
     }
 }
+
+/// "What would stop it": one-parameter changes that silence the default brake,
+/// checked against the one-DOF criterion c_px + N·μ'(V) = 0 of its pad mode.
+#[test]
+fn stability_names_what_would_stop_the_squeal() {
+    let d = tempfile::tempdir().unwrap();
+    let j = json(&squeal(d.path(), &["stability", "--json"]));
+    let levers = j["levers"].as_array().unwrap();
+    let find = |p: &str| {
+        levers
+            .iter()
+            .find(|l| l["param"] == p)
+            .unwrap_or_else(|| panic!("no lever {p}: {levers:?}"))
+    };
+    let (f0, f1, uc, c_px) = (0.1, 1.0 / 15.0, 50.0 / 3.0, 0.2);
+    // Raise V to V_H = Uc (1 − c_px/(N f0 f1)).
+    let v_h = uc * (1.0 - c_px / (500.0 * f0 * f1));
+    let v = find("V")["to"].as_f64().unwrap();
+    assert!((v - v_h).abs() <= 1e-7 * v_h, "{v} vs {v_h}");
+    // Lower N to c_px / (f0 f1 (1 − V/Uc)): the one-DOF value, which the coupled
+    // eigenvalues shift by the disc–pad friction coupling (measured 1.3e-4).
+    let n_c = c_px / (f0 * f1 * (1.0 - 1.0 / uc));
+    let n = find("N")["to"].as_f64().unwrap();
+    assert!((n - n_c).abs() <= 1e-3 * n_c, "{n} vs {n_c}");
+    // Damping of one part alone cannot silence both the disc and the pad.
+    assert!(
+        levers
+            .iter()
+            .all(|l| l["param"] != "c_dx" && l["param"] != "c_px"),
+        "{levers:?}"
+    );
+    let text = String::from_utf8_lossy(&squeal(d.path(), &["stability"]).stdout).to_string();
+    assert!(
+        text.contains("what would stop it") && text.contains("raise V"),
+        "{text}"
+    );
+}

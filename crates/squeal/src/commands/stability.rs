@@ -9,7 +9,7 @@ use crate::scenario::InputError;
 use crate::ScenarioArgs;
 use clap::Args;
 use serde_json::{json, Value};
-use squeal_core::stability::{self, Analysis, StabilityError};
+use squeal_core::stability::{self, Analysis, CriticalOptions, StabilityError};
 
 /// Arguments of `squeal stability`.
 #[derive(Args, Debug)]
@@ -66,13 +66,81 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
     })
 }
 
+/// One parameter change that alone flips the verdict (all else as is).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lever {
+    /// Parameter name.
+    pub param: &'static str,
+    /// Its unit.
+    pub unit: &'static str,
+    /// Its current value.
+    pub from: f64,
+    /// The value where the verdict flips.
+    pub to: f64,
+    /// Frequency (Hz) of the mode that crosses there.
+    pub freq_hz: f64,
+}
+
+/// "What would stop it" (or, for a quiet brake, what would start it): for
+/// every parameter, the nearest value above and below the current one where
+/// the stability of steady sliding changes, searched over ×1000 either way
+/// (±1e5 for a signed parameter) by [`stability::critical`].
+pub fn levers(model: &AnyModel) -> Vec<Lever> {
+    use squeal_core::params::ParamKind;
+    let specs = model.param_specs().iter().chain(model.friction().params());
+    let mut out = Vec::new();
+    for spec in specs {
+        if spec.name == "t_ramp" {
+            continue; // a start-up setting, no part of steady sliding
+        }
+        let Some(cur) = model.get(spec.name) else {
+            continue;
+        };
+        let (lo, hi) = match spec.kind {
+            ParamKind::Positive => (cur / 1000.0, cur * 1000.0),
+            ParamKind::NonNegative => (0.0, if cur > 0.0 { cur * 1000.0 } else { 1000.0 }),
+            ParamKind::Any => (
+                cur - 1e5 * cur.abs().max(1.0),
+                cur + 1e5 * cur.abs().max(1.0),
+            ),
+        };
+        for (a, b) in [(cur, hi), (cur, lo)] {
+            if (b - a).abs() <= 1e-12 * a.abs().max(1e-300) {
+                continue;
+            }
+            // Search outwards from the current value: s ∈ [0, 1] maps to a + s (b − a).
+            let f =
+                |s: f64| crate::commands::critical::growth_at(model, spec.name, a + s * (b - a));
+            let opts = CriticalOptions {
+                grid: 48,
+                ..CriticalOptions::default()
+            };
+            if let Ok(Some(c)) = stability::critical(f, 0.0, 1.0, &opts) {
+                out.push(Lever {
+                    param: spec.name,
+                    unit: spec.unit,
+                    from: cur,
+                    to: a + c.value * (b - a),
+                    freq_hz: c.freq_hz,
+                });
+            }
+        }
+    }
+    out
+}
+
 /// Run the command.
 pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
     let an = analyse(&sc.model).map_err(stability_error)?;
+    let levers = levers(&sc.model);
     if a.json {
         let mut doc = analysis_json(&sc.model, &an);
         doc["scenario"] = sc.to_json();
+        doc["levers"] = json!(levers
+            .iter()
+            .map(|l| json!({ "param": l.param, "from": l.from, "to": l.to, "freq_hz": l.freq_hz }))
+            .collect::<Vec<_>>());
         println!(
             "{}",
             serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
@@ -111,5 +179,28 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         "least stable mode: {:.2} Hz, dominated by {}, σ = {:+.6e} 1/s",
         ls.freq_hz, ls.dominant_name, ls.re
     );
+    if levers.is_empty() {
+        println!("no single parameter change within ×1000 either way changes the verdict");
+    } else {
+        println!(
+            "{} by changing one parameter (all others as they are):",
+            if an.stable {
+                "it would start to squeal"
+            } else {
+                "what would stop it"
+            }
+        );
+        for l in &levers {
+            let verb = if l.to > l.from { "raise" } else { "lower" };
+            println!(
+                "  {verb} {:<6} from {:<11} to {:.6e} {} (the {:.1} Hz mode crosses there)",
+                l.param,
+                format!("{:.4e}", l.from),
+                l.to,
+                l.unit,
+                l.freq_hz
+            );
+        }
+    }
     Ok(())
 }
