@@ -47,6 +47,59 @@ pub struct Scenario {
     pub solver: SolverOptions,
 }
 
+/// The 40 reconstructed sets of Table 11.1, embedded so that the command
+/// works from any folder (the same files users can run one by one).
+pub const THESIS_SETS: [&str; 40] = [
+    include_str!("../../../scenarios/thesis/set01.toml"),
+    include_str!("../../../scenarios/thesis/set02.toml"),
+    include_str!("../../../scenarios/thesis/set03.toml"),
+    include_str!("../../../scenarios/thesis/set04.toml"),
+    include_str!("../../../scenarios/thesis/set05.toml"),
+    include_str!("../../../scenarios/thesis/set06.toml"),
+    include_str!("../../../scenarios/thesis/set07.toml"),
+    include_str!("../../../scenarios/thesis/set08.toml"),
+    include_str!("../../../scenarios/thesis/set09.toml"),
+    include_str!("../../../scenarios/thesis/set10.toml"),
+    include_str!("../../../scenarios/thesis/set11.toml"),
+    include_str!("../../../scenarios/thesis/set12.toml"),
+    include_str!("../../../scenarios/thesis/set13.toml"),
+    include_str!("../../../scenarios/thesis/set14.toml"),
+    include_str!("../../../scenarios/thesis/set15.toml"),
+    include_str!("../../../scenarios/thesis/set16.toml"),
+    include_str!("../../../scenarios/thesis/set17.toml"),
+    include_str!("../../../scenarios/thesis/set18.toml"),
+    include_str!("../../../scenarios/thesis/set19.toml"),
+    include_str!("../../../scenarios/thesis/set20.toml"),
+    include_str!("../../../scenarios/thesis/set21.toml"),
+    include_str!("../../../scenarios/thesis/set22.toml"),
+    include_str!("../../../scenarios/thesis/set23.toml"),
+    include_str!("../../../scenarios/thesis/set24.toml"),
+    include_str!("../../../scenarios/thesis/set25.toml"),
+    include_str!("../../../scenarios/thesis/set26.toml"),
+    include_str!("../../../scenarios/thesis/set27.toml"),
+    include_str!("../../../scenarios/thesis/set28.toml"),
+    include_str!("../../../scenarios/thesis/set29.toml"),
+    include_str!("../../../scenarios/thesis/set30.toml"),
+    include_str!("../../../scenarios/thesis/set31.toml"),
+    include_str!("../../../scenarios/thesis/set32.toml"),
+    include_str!("../../../scenarios/thesis/set33.toml"),
+    include_str!("../../../scenarios/thesis/set34.toml"),
+    include_str!("../../../scenarios/thesis/set35.toml"),
+    include_str!("../../../scenarios/thesis/set36.toml"),
+    include_str!("../../../scenarios/thesis/set37.toml"),
+    include_str!("../../../scenarios/thesis/set38.toml"),
+    include_str!("../../../scenarios/thesis/set39.toml"),
+    include_str!("../../../scenarios/thesis/set40.toml"),
+];
+
+/// The reconstructed thesis sets as scenarios (`thesis-01` … `thesis-40`).
+pub fn thesis_sets() -> Vec<Scenario> {
+    THESIS_SETS
+        .iter()
+        .map(|t| Scenario::from_toml(t).expect("the shipped thesis sets are valid"))
+        .collect()
+}
+
 /// Names of the built-in scenarios.
 pub const BUILTINS: [&str; 4] = ["disc-pad", "belt-coulomb", "belt", "hoffmann"];
 
@@ -63,6 +116,14 @@ impl Scenario {
             initial: Initial::Rest,
             solver: SolverOptions::default(),
         };
+        if let Some(n) = name
+            .strip_prefix("thesis-")
+            .and_then(|n| n.parse::<usize>().ok())
+        {
+            return (1..=40).contains(&n).then(|| {
+                Scenario::from_toml(THESIS_SETS[n - 1]).expect("the shipped thesis sets are valid")
+            });
+        }
         Some(match name {
             "disc-pad" => {
                 let mut s = base(
@@ -143,7 +204,7 @@ impl Scenario {
         }
         Scenario::builtin(spec).ok_or_else(|| {
             InputError(format!(
-                "scenario '{spec}': no such file, and no built-in of that name (built-ins: {})",
+                "scenario '{spec}': no such file, and no built-in of that name (built-ins: {}, thesis-01 … thesis-40)",
                 BUILTINS.join(", ")
             ))
         })

@@ -21,51 +21,6 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// The 40 reconstructed sets of Table 11.1, embedded so that the command
-/// works from any folder (the same files users can run one by one).
-const SETS: [&str; 40] = [
-    include_str!("../../../../scenarios/thesis/set01.toml"),
-    include_str!("../../../../scenarios/thesis/set02.toml"),
-    include_str!("../../../../scenarios/thesis/set03.toml"),
-    include_str!("../../../../scenarios/thesis/set04.toml"),
-    include_str!("../../../../scenarios/thesis/set05.toml"),
-    include_str!("../../../../scenarios/thesis/set06.toml"),
-    include_str!("../../../../scenarios/thesis/set07.toml"),
-    include_str!("../../../../scenarios/thesis/set08.toml"),
-    include_str!("../../../../scenarios/thesis/set09.toml"),
-    include_str!("../../../../scenarios/thesis/set10.toml"),
-    include_str!("../../../../scenarios/thesis/set11.toml"),
-    include_str!("../../../../scenarios/thesis/set12.toml"),
-    include_str!("../../../../scenarios/thesis/set13.toml"),
-    include_str!("../../../../scenarios/thesis/set14.toml"),
-    include_str!("../../../../scenarios/thesis/set15.toml"),
-    include_str!("../../../../scenarios/thesis/set16.toml"),
-    include_str!("../../../../scenarios/thesis/set17.toml"),
-    include_str!("../../../../scenarios/thesis/set18.toml"),
-    include_str!("../../../../scenarios/thesis/set19.toml"),
-    include_str!("../../../../scenarios/thesis/set20.toml"),
-    include_str!("../../../../scenarios/thesis/set21.toml"),
-    include_str!("../../../../scenarios/thesis/set22.toml"),
-    include_str!("../../../../scenarios/thesis/set23.toml"),
-    include_str!("../../../../scenarios/thesis/set24.toml"),
-    include_str!("../../../../scenarios/thesis/set25.toml"),
-    include_str!("../../../../scenarios/thesis/set26.toml"),
-    include_str!("../../../../scenarios/thesis/set27.toml"),
-    include_str!("../../../../scenarios/thesis/set28.toml"),
-    include_str!("../../../../scenarios/thesis/set29.toml"),
-    include_str!("../../../../scenarios/thesis/set30.toml"),
-    include_str!("../../../../scenarios/thesis/set31.toml"),
-    include_str!("../../../../scenarios/thesis/set32.toml"),
-    include_str!("../../../../scenarios/thesis/set33.toml"),
-    include_str!("../../../../scenarios/thesis/set34.toml"),
-    include_str!("../../../../scenarios/thesis/set35.toml"),
-    include_str!("../../../../scenarios/thesis/set36.toml"),
-    include_str!("../../../../scenarios/thesis/set37.toml"),
-    include_str!("../../../../scenarios/thesis/set38.toml"),
-    include_str!("../../../../scenarios/thesis/set39.toml"),
-    include_str!("../../../../scenarios/thesis/set40.toml"),
-];
-
 /// Arguments of `squeal reproduce`.
 #[derive(Args, Debug)]
 pub struct ReproduceArgs {
@@ -81,12 +36,7 @@ pub struct ReproduceArgs {
     no_figures: bool,
 }
 
-/// The reconstructed sets as scenarios.
-pub fn thesis_sets() -> Vec<Scenario> {
-    SETS.iter()
-        .map(|t| Scenario::from_toml(t).expect("the shipped thesis sets are valid"))
-        .collect()
-}
+use crate::scenario::thesis_sets;
 
 /// Linear stability of one set (sets at V = 0 have no steady sliding).
 #[derive(Debug, Clone)]

@@ -9,7 +9,7 @@ use clap::Subcommand;
 pub enum ScenarioCmd {
     /// List the built-in scenarios.
     List,
-    /// Print a built-in scenario as a documented TOML file.
+    /// Print a built-in scenario (or a thesis set, thesis-01 … thesis-40) as a documented TOML file.
     Show {
         /// Built-in scenario name.
         name: String,
@@ -23,6 +23,9 @@ pub fn run(cmd: ScenarioCmd) -> Result<(), RunError> {
             for name in BUILTINS {
                 let s = Scenario::builtin(name).expect("listed built-ins exist");
                 println!("{name:<14} {}", s.description);
+            }
+            for (i, s) in crate::scenario::thesis_sets().iter().enumerate() {
+                println!("thesis-{:02}      {}", i + 1, s.description);
             }
         }
         ScenarioCmd::Show { name } => {
