@@ -765,28 +765,43 @@ fn report_html(md: &str) -> String {
             .replace('<', "&lt;")
             .replace('>', "&gt;")
     }
+    /// `code`, **bold** and *italic*; a `*` counts as emphasis only at a word
+    /// boundary (so `F_t*` stays a star) and open tags close at the line's end.
     fn inline(s: &str) -> String {
-        let mut out = String::new();
-        let mut bold = false;
-        let mut ital = false;
-        let mut code = false;
         let chars: Vec<char> = esc(s).chars().collect();
+        let at = |i: usize| chars.get(i).copied();
+        let opens = |i: usize, len: usize| {
+            (i == 0 || at(i - 1).is_some_and(|c| c.is_whitespace() || c == '('))
+                && at(i + len).is_some_and(|c| !c.is_whitespace())
+        };
+        let closes = |i: usize| i > 0 && at(i - 1).is_some_and(|c| !c.is_whitespace());
+        let (mut out, mut bold, mut ital, mut code) = (String::new(), false, false, false);
         let mut i = 0;
         while i < chars.len() {
-            if chars[i] == '`' {
+            let c = chars[i];
+            if c == '`' {
                 out.push_str(if code { "</code>" } else { "<code>" });
                 code = !code;
-            } else if !code && chars[i] == '*' && chars.get(i + 1) == Some(&'*') {
+            } else if !code
+                && c == '*'
+                && at(i + 1) == Some('*')
+                && (if bold { closes(i) } else { opens(i, 2) })
+            {
                 out.push_str(if bold { "</strong>" } else { "<strong>" });
                 bold = !bold;
                 i += 1;
-            } else if !code && chars[i] == '*' {
+            } else if !code && c == '*' && (if ital { closes(i) } else { opens(i, 1) }) {
                 out.push_str(if ital { "</em>" } else { "<em>" });
                 ital = !ital;
             } else {
-                out.push(chars[i]);
+                out.push(c);
             }
             i += 1;
+        }
+        for (open, tag) in [(ital, "</em>"), (bold, "</strong>"), (code, "</code>")] {
+            if open {
+                out.push_str(tag);
+            }
         }
         out
     }
@@ -984,4 +999,22 @@ pub fn run(a: ReproduceArgs) -> Result<(), RunError> {
     }
     println!("report: {}", dest.join("report.html").display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn html_emphasis_stays_balanced() {
+        let h = report_html("**1. Claim** — *Evidence:* the terms α·F_t* ≈ α·μ·N, `a*b` and 2 * 3.\n\n| a | b |\n|---|---|\n| 1 | 2 |\n");
+        assert!(h.contains("<strong>1. Claim</strong>"), "{h}");
+        assert!(h.contains("<em>Evidence:</em>"), "{h}");
+        assert!(
+            h.contains("F_t* ≈") && h.contains("<code>a*b</code>") && h.contains("2 * 3"),
+            "{h}"
+        );
+        assert_eq!(h.matches("<em>").count(), h.matches("</em>").count());
+        assert!(h.contains("<table>") && h.contains("<td>1</td>"));
+    }
 }
