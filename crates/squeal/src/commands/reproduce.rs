@@ -542,6 +542,9 @@ fn opt(x: Option<f64>, prec: usize) -> String {
         .map_or(String::new(), |v| format!("{v:.prec$}"))
 }
 
+/// The parameters the table shows for every set (the ones the sets vary).
+const TABLE_PARAMS: [&str; 8] = ["V", "N", "f1", "alpha", "c_dx", "c_dy", "c_px", "c_py"];
+
 const TABLE_HEADER: &str = "set,question,V,N,f1,alpha,c_dx,c_dy,c_px,c_py,duration,linear,max_growth_rate,least_stable_hz,verdict,tangential_hz,normal_hz,growth_rate_vx_p,growth_rate_vx_d,stick_fraction,reversals,sticks,tangential_zero,agree";
 
 fn table_csv(rs: &[SetResult]) -> String {
@@ -549,19 +552,13 @@ fn table_csv(rs: &[SetResult]) -> String {
     t.push('\n');
     for r in rs {
         let q = r.sc.description.replace('"', "'");
+        let params: Vec<String> = TABLE_PARAMS.iter().map(|k| r.p(k).to_string()).collect();
         let _ = writeln!(
             t,
-            "{},\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{},{},{},{}",
+            "{},\"{}\",{},{},{},{},{},{},{},{},{},{},{:e},{},{},{},{}",
             r.id,
             q,
-            r.p("V"),
-            r.p("N"),
-            r.p("f1"),
-            r.p("alpha"),
-            r.p("c_dx"),
-            r.p("c_dy"),
-            r.p("c_px"),
-            r.p("c_py"),
+            params.join(","),
             r.sc.duration,
             r.linear_word(),
             r.linear
@@ -688,21 +685,26 @@ fn report_md(rs: &[SetResult], cs: &[Conclusion], scale: f64, figures: bool, wal
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for r in rs {
+        let params: Vec<String> = TABLE_PARAMS
+            .iter()
+            .map(|k| {
+                if *k == "f1" {
+                    format!("{:.4}", r.p(k))
+                } else {
+                    r.p(k).to_string()
+                }
+            })
+            .collect();
         let _ = writeln!(
             m,
-            "| {} | {} | {} | {} | {:.4} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2e} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2e} | {} |",
             r.id,
             r.sc.description,
-            r.p("V"),
-            r.p("N"),
-            r.p("f1"),
-            r.p("alpha"),
-            r.p("c_dx"),
-            r.p("c_dy"),
-            r.p("c_px"),
-            r.p("c_py"),
+            params.join(" | "),
             r.linear_word(),
-            r.linear.as_ref().map_or("—".into(), |l| format!("{:+.3}", l.max_growth)),
+            r.linear
+                .as_ref()
+                .map_or("—".into(), |l| format!("{:+.3}", l.max_growth)),
             r.verdict,
             opt(r.f_t, 1),
             opt(r.f_n, 1),
