@@ -63,6 +63,9 @@ impl Default for SolverOptions {
     }
 }
 
+/// Most mode changes in a row at one instant before it counts as chatter.
+const SETTLE_LIMIT: usize = 16;
+
 /// Most states a per-state tolerance can be given for.
 pub const MAX_STATES: usize = 16;
 
@@ -195,7 +198,10 @@ pub struct Solver<'m, M: Model<N>, const N: usize> {
     stats: Stats,
     last_event_t: f64,
     zeno_run: u32,
-    pending: Option<(EventKind, [f64; N], Mode)>,
+    /// Events fired while settling a mode (at most [`SETTLE_LIMIT`]), oldest first.
+    pending: [(EventKind, [f64; N], Mode); SETTLE_LIMIT],
+    pending_len: usize,
+    pending_next: usize,
 }
 
 /// Default absolute tolerances: positions, velocities (a model-dependent scale
@@ -276,7 +282,9 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
             stats: Stats::default(),
             last_event_t: f64::NEG_INFINITY,
             zeno_run: 0,
-            pending: None,
+            pending: [(EventKind::Stick, [0.0; N], Mode::Free); SETTLE_LIMIT],
+            pending_len: 0,
+            pending_next: 0,
         };
         s.enter_mode(mode)?;
         s.h = match opts.h_init {
@@ -306,10 +314,15 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
     pub fn finished(&self) -> bool {
         self.t >= self.t_end
     }
-    /// An event the solver fired while settling the mode at the start or
-    /// after a transition (reported once, then cleared).
+    /// The events the solver fired while settling the mode at the start or
+    /// after the last transition, oldest first, each reported once.
     pub fn take_pending_event(&mut self) -> Option<(EventKind, [f64; N], Mode)> {
-        self.pending.take()
+        if self.pending_next < self.pending_len {
+            self.pending_next += 1;
+            Some(self.pending[self.pending_next - 1])
+        } else {
+            None
+        }
     }
 
     #[inline]
@@ -322,7 +335,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
     /// and fire at once any guard that is already on its surface and moving out
     /// (a mode that is left as soon as it is entered).
     fn enter_mode(&mut self, mut mode: Mode) -> Result<(), IntegrateError> {
-        for _ in 0..16 {
+        for _ in 0..SETTLE_LIMIT {
             self.mode = mode;
             self.model.guards(mode, &mut self.guards);
             let (t, z) = (self.t, self.z);
@@ -352,7 +365,10 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
             self.z = z;
             if let Some(ev) = ev {
                 self.note_event(ev)?;
-                self.pending = Some((ev, self.z, next));
+                if self.pending_len < SETTLE_LIMIT {
+                    self.pending[self.pending_len] = (ev, self.z, next);
+                    self.pending_len += 1;
+                }
             }
             if next == mode {
                 return Ok(());
@@ -361,7 +377,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
         }
         Err(IntegrateError::Chatter {
             t: self.t,
-            count: 16,
+            count: SETTLE_LIMIT as u32,
             gap: 0.0,
         })
     }
@@ -679,7 +695,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
                 if let Some(ev) = ev {
                     self.note_event(ev)?;
                 }
-                self.pending = None;
+                (self.pending_len, self.pending_next) = (0, 0);
                 self.enter_mode(next)?;
                 // A step cut short by an event: restart no larger than the part used.
                 self.h = self.h.min(h);
@@ -723,7 +739,7 @@ pub fn simulate<M: Model<N>, S: Sink<N>, const N: usize>(
         )));
     }
     let mut solver = Solver::new(model, t0, z0, t_end, opts)?;
-    if let Some((ev, z, m)) = solver.take_pending_event() {
+    while let Some((ev, z, m)) = solver.take_pending_event() {
         sink.event(t0, ev, &z, m);
     }
     let dt = 1.0 / sample_rate;
@@ -764,7 +780,7 @@ pub fn simulate<M: Model<N>, S: Sink<N>, const N: usize>(
         if let Some(ev) = seg.event {
             sink.event(seg.t1, ev, solver.state(), solver.mode());
         }
-        if let Some((ev, z, m)) = solver.take_pending_event() {
+        while let Some((ev, z, m)) = solver.take_pending_event() {
             sink.event(seg.t1, ev, &z, m);
         }
     }
