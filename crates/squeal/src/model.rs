@@ -72,7 +72,7 @@ impl AnyModel {
     }
     /// The friction law.
     pub fn friction(&self) -> squeal_core::FrictionLaw {
-        with_model!(self, m => m.friction)
+        *with_model!(self, m => m.friction_law())
     }
     /// Replace the friction law.
     pub fn set_friction(&mut self, law: squeal_core::FrictionLaw) {

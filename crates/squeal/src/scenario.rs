@@ -721,6 +721,8 @@ mod tests {
 
     #[test]
     fn overrides_switch_laws_and_keep_shared_parameters() {
+        let refused =
+            |s: &Scenario, set: &str| s.clone().apply_overrides(&[set.into()]).unwrap_err().0;
         let mut s = Scenario::builtin("disc-pad").unwrap();
         s.apply_overrides(&[
             "mu_k=0.05".into(),
@@ -731,23 +733,11 @@ mod tests {
         assert_eq!(s.model.get("N"), Some(2000.0));
         assert_eq!(s.model.friction().name(), "coulomb");
         assert_eq!(s.model.get("mu_k"), Some(0.05));
-        let e = s
-            .clone()
-            .apply_overrides(&["mu_k=0.5".into()])
-            .unwrap_err()
-            .0;
+        let e = refused(&s, "mu_k=0.5");
         assert!(e.contains("mu_s") && e.contains("mu_k"), "{e}");
-        let e = s
-            .clone()
-            .apply_overrides(&["k_dx=-1".into()])
-            .unwrap_err()
-            .0;
+        let e = refused(&s, "k_dx=-1");
         assert!(e.contains("k_dx") && e.contains("-1"), "{e}");
-        let e = s
-            .clone()
-            .apply_overrides(&["bogus=1".into()])
-            .unwrap_err()
-            .0;
+        let e = refused(&s, "bogus=1");
         assert!(e.contains("bogus"), "{e}");
         s.apply_overrides(&["x_p0=1e-9".into(), "initial=equilibrium".into()])
             .unwrap();
@@ -756,11 +746,7 @@ mod tests {
         s.apply_overrides(&["atol_vx_p=1e-12".into()]).unwrap();
         assert_eq!(s.solver.atol_state[5], Some(1e-12));
         assert_eq!(Scenario::from_toml(&s.to_toml()).unwrap().solver, s.solver);
-        let e = s
-            .clone()
-            .apply_overrides(&["atol_vx_p=-1".into()])
-            .unwrap_err()
-            .0;
+        let e = refused(&s, "atol_vx_p=-1");
         assert!(e.contains("atol_vx_p"), "{e}");
     }
 }

@@ -312,11 +312,8 @@ impl Parameters for DiscPad {
         Ok(())
     }
 
-    fn validate(&self) -> Result<(), ParamError> {
-        for spec in SPECS {
-            spec.check(self.get(spec.name).unwrap_or(f64::NAN))?;
-        }
-        self.friction.validate()
+    fn friction_law(&self) -> &FrictionLaw {
+        &self.friction
     }
 }
 

@@ -242,6 +242,11 @@ impl Parameters for Hoffmann {
         }
     }
 
+    fn friction_law(&self) -> &FrictionLaw {
+        &self.friction
+    }
+
+    /// As the default, but `mu` is checked only under the Coulomb law.
     fn validate(&self) -> Result<(), ParamError> {
         for spec in SPECS {
             if spec.name == "mu" && !matches!(self.friction, FrictionLaw::Coulomb { .. }) {

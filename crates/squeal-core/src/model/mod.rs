@@ -253,8 +253,16 @@ pub trait Parameters {
     fn get(&self, key: &str) -> Option<f64>;
     /// Set a parameter (model or friction law) by name, checking its sign.
     fn set(&mut self, key: &str, value: f64) -> Result<(), ParamError>;
-    /// Check relations between parameters.
-    fn validate(&self) -> Result<(), ParamError>;
+    /// The model's friction law.
+    fn friction_law(&self) -> &crate::FrictionLaw;
+    /// Check every parameter's sign and the relations between them (the
+    /// friction law's included).
+    fn validate(&self) -> Result<(), ParamError> {
+        for spec in self.param_specs() {
+            spec.check(self.get(spec.name).unwrap_or(f64::NAN))?;
+        }
+        self.friction_law().validate()
+    }
 }
 
 /// Shared decision when the sliding velocity reaches zero, or contact is
