@@ -198,6 +198,8 @@ impl Scenario {
             if !named {
                 if let Some(stem) = path.file_stem() {
                     sc.name = stem.to_string_lossy().into_owned();
+                    check_name(&sc.name)
+                        .map_err(|e| InputError(format!("{spec}: no `name` key, and {}", e.0)))?;
                 }
             }
             return Ok(sc);
@@ -260,7 +262,10 @@ impl Scenario {
         for (key, value) in &table {
             match (key.as_str(), value) {
                 ("model", _) => {}
-                ("name", toml::Value::String(v)) => s.name = v.clone(),
+                ("name", toml::Value::String(v)) => {
+                    check_name(v)?;
+                    s.name = v.clone();
+                }
                 ("description", toml::Value::String(v)) => s.description = v.clone(),
                 ("params" | "friction" | "offsets" | "solver", toml::Value::Table(t)) => {
                     for (k, v) in t {
@@ -294,10 +299,11 @@ impl Scenario {
     /// Apply `--set KEY=VALUE` overrides: friction-law switches first, then
     /// the rest in order; then validate.
     pub fn apply_overrides(&mut self, sets: &[String]) -> Result<(), InputError> {
+        check_set_syntax(sets, "")?;
         let mut parsed = Vec::new();
         for raw in sets {
             let Some((k, v)) = raw.split_once('=') else {
-                return err(format!("--set {raw}: expected NAME=VALUE"));
+                return err(format!("--set {raw}: --set needs NAME=VALUE"));
             };
             parsed.push((k.trim().to_string(), v.trim().to_string(), raw));
         }
@@ -330,13 +336,49 @@ impl Scenario {
             }
             _ => {
                 return err(format!(
-                    "unknown key '{key}' for model {} with the {} friction law",
+                    "unknown key '{key}' for model {} with the {} friction law; {}",
                     self.model.name(),
-                    self.model.friction().name()
+                    self.model.friction().name(),
+                    suggest(key, &self.known_keys())
                 ))
             }
         };
         self.apply_in(section, key, value)
+    }
+
+    /// Every key `--set` accepts for this scenario's model and friction law.
+    pub fn known_keys(&self) -> Vec<String> {
+        let mut keys: Vec<String> = self
+            .model
+            .param_specs()
+            .iter()
+            .chain(self.model.friction().params())
+            .filter(|p| self.model.get(p.name).is_some())
+            .map(|p| p.name.to_string())
+            .collect();
+        keys.extend(
+            [
+                "friction",
+                "initial",
+                "duration",
+                "sample_rate",
+                "name",
+                "description",
+                "rtol",
+                "atol_pos",
+                "atol_vel",
+                "h_max",
+            ]
+            .map(String::from),
+        );
+        if matches!(self.model, AnyModel::DiscPad(_)) {
+            keys.push("contact".into());
+        }
+        for n in self.model.state_names() {
+            keys.push(format!("{n}0"));
+            keys.push(format!("atol_{n}"));
+        }
+        keys
     }
 
     /// `atol_<state>`: a per-state absolute tolerance.
@@ -396,7 +438,11 @@ impl Scenario {
                     }
                 }
             }
-            ("", "name") => self.name = text(value)?,
+            ("", "name") => {
+                let name = text(value)?;
+                check_name(&name)?;
+                self.name = name;
+            }
             ("", "description") => self.description = text(value)?,
             ("", "duration") => {
                 let x = number(value)?;
@@ -475,10 +521,21 @@ impl Scenario {
                         || self.model.friction().get(k).is_some()
                 };
                 if !known {
+                    let mut keys: Vec<String> = self
+                        .model
+                        .friction()
+                        .params()
+                        .iter()
+                        .map(|p| p.name.to_string())
+                        .collect();
+                    if section == "params" {
+                        keys.extend(self.model.param_specs().iter().map(|p| p.name.to_string()));
+                    }
                     return err(format!(
-                        "unknown parameter '{shown}' for model {} with the {} friction law",
+                        "unknown parameter '{shown}' for model {} with the {} friction law; {}",
                         self.model.name(),
-                        self.model.friction().name()
+                        self.model.friction().name(),
+                        suggest(k, &keys)
                     ));
                 }
                 self.model
@@ -683,6 +740,88 @@ impl Scenario {
             );
         }
         t
+    }
+}
+
+/// Longest scenario name (the output folder `out/<name>-map` must stay a
+/// legal file name).
+pub const MAX_NAME_BYTES: usize = 200;
+
+/// A scenario's `name` names its output folder `out/<name>`: it must be a
+/// plain name, not a path — not empty, no `/` or `\`, no control
+/// characters, not starting with `.` (so neither `.`, `..` nor a hidden
+/// folder), at most [`MAX_NAME_BYTES`] bytes.
+pub fn check_name(name: &str) -> Result<(), InputError> {
+    let why = if name.is_empty() {
+        Some("is empty")
+    } else if name.contains(['/', '\\']) {
+        Some("is a path; give a plain name (it names the folder out/<name>)")
+    } else if name.starts_with('.') {
+        Some("must not start with '.' (it names the folder out/<name>)")
+    } else if name.chars().any(char::is_control) {
+        Some("contains a control character")
+    } else if name.len() > MAX_NAME_BYTES {
+        Some("is longer than 200 bytes")
+    } else {
+        None
+    };
+    match why {
+        Some(why) => err(format!("name = {name:?}: {why}")),
+        None => Ok(()),
+    }
+}
+
+/// Every `--set` must be `NAME=VALUE`. `--set V 2` (a space for the `=`)
+/// makes `2` the scenario: say what was meant. `scenario` is the scenario
+/// argument as given ("" if unknown).
+pub fn check_set_syntax(sets: &[String], scenario: &str) -> Result<(), InputError> {
+    let Some(raw) = sets.iter().find(|s| !s.contains('=')) else {
+        return Ok(());
+    };
+    let loose = !scenario.is_empty()
+        && !Path::new(scenario).exists()
+        && Scenario::builtin(scenario).is_none();
+    let hint = if loose {
+        format!("; did you mean --set {raw}={scenario}?")
+    } else {
+        format!("; e.g. --set {}=VALUE", raw.trim())
+    };
+    err(format!("--set {raw}: --set needs NAME=VALUE{hint}"))
+}
+
+/// Levenshtein distance (for suggestions).
+fn distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+/// "did you mean N?" for a near key (same letters in another case, or one
+/// or two edits away), else the list of valid keys.
+pub fn suggest(key: &str, keys: &[String]) -> String {
+    let near = keys
+        .iter()
+        .map(|k| {
+            let d = if k.eq_ignore_ascii_case(key) {
+                0
+            } else {
+                distance(&k.to_lowercase(), &key.to_lowercase()) + 1
+            };
+            (d, k)
+        })
+        .min();
+    match near {
+        Some((d, k)) if d <= 2 || (d <= 3 && key.len() > 4) => format!("did you mean '{k}'?"),
+        _ => format!("valid keys: {}", keys.join(", ")),
     }
 }
 

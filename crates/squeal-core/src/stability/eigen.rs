@@ -60,7 +60,10 @@ pub fn balance<const N: usize>(a: &mut [[f64; N]; N]) -> [f64; N] {
                     r += a[i][j].abs();
                 }
             }
-            if c == 0.0 || r == 0.0 {
+            // A zero row or column needs no scaling; a non-finite sum (an
+            // infinite or NaN entry, or 1-norms that overflow) cannot be
+            // balanced: the scaling loops below would never end on it.
+            if c == 0.0 || r == 0.0 || !(c + r).is_finite() {
                 continue;
             }
             let s = c + r;

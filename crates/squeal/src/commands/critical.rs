@@ -47,6 +47,18 @@ pub fn parse_interval(spec: &str, flag: &str) -> Result<(String, f64, f64), Inpu
     Ok((name.trim().to_string(), lo, hi))
 }
 
+/// Both ends of a range must be values the parameter may take: the reason
+/// the one that is not cannot, naming it (LO or HI).
+pub fn check_endpoints(model: &AnyModel, name: &str, lo: f64, hi: f64) -> Result<(), String> {
+    for (end, v) in [("LO", lo), ("HI", hi)] {
+        let mut m = *model;
+        if let Err(e) = m.set(name, v) {
+            return Err(format!("{end} = {v}: {e}"));
+        }
+    }
+    Ok(())
+}
+
 /// Least stable growth rate and its frequency with `name` set to `value`.
 pub fn growth_at(model: &AnyModel, name: &str, value: f64) -> Result<(f64, f64), StabilityError> {
     let mut m = *model;
@@ -70,6 +82,8 @@ pub fn locate(
         ))
         .into());
     }
+    check_endpoints(model, name, lo, hi)
+        .map_err(|why| InputError(format!("--param {name}={lo}:{hi}: {why}")))?;
     let opts = CriticalOptions {
         grid,
         ..CriticalOptions::default()
@@ -83,7 +97,18 @@ pub fn locate(
             lo = nudged;
         }
     }
-    stability::critical(|p| growth_at(model, name, p), lo, hi, &opts).map_err(stability_error)
+    let at = |p: f64| {
+        growth_at(model, name, p).map_err(|e| match e {
+            StabilityError::NonFinite { what } => StabilityError::BadInput(format!(
+                "--param {name}={lo}:{hi}: at {name} = {p:e} the {what} at steady sliding is not finite (it overflows)"
+            )),
+            other => other,
+        })
+    };
+    stability::critical(at, lo, hi, &opts).map_err(|e| match e {
+        StabilityError::BadInput(msg) => RunError::Input(InputError(msg)),
+        other => stability_error(other),
+    })
 }
 
 /// Run the command.
@@ -102,14 +127,14 @@ pub fn run(a: CriticalArgs) -> Result<(), RunError> {
             }),
             None => json!({ "param": name, "value": null, "freq_hz": null }),
         };
-        println!(
+        crate::outln!(
             "{}",
             serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
         );
         return Ok(());
     }
     match found {
-        None => println!(
+        None => crate::outln!(
             "{}: no change of stability for {name} in [{lo}, {hi}]",
             sc.name
         ),
@@ -123,9 +148,11 @@ pub fn run(a: CriticalArgs) -> Result<(), RunError> {
             } else {
                 "Hopf point"
             };
-            println!(
+            crate::outln!(
                 "{}: critical {name} = {:.12e} ({kind}; {side}); the crossing mode is at {:.3} Hz",
-                sc.name, c.value, c.freq_hz
+                sc.name,
+                c.value,
+                c.freq_hz
             );
         }
     }

@@ -1,0 +1,293 @@
+//! What a run will cost, checked before it starts — the same way for every
+//! command that simulates (`simulate`, `listen`, `map --transient`,
+//! `reproduce`): the memory of its series, its sample rate against the
+//! model's fastest mode, and the work an explicit integrator needs for its
+//! stiffest time scale (which also sets the run's step budget).
+
+use crate::model::AnyModel;
+use crate::run::RunError;
+use crate::scenario::{InputError, Scenario};
+use squeal_core::integrate::budget::{min_steps, step_budget};
+use squeal_core::stability::{self, Inertia, StabilityError};
+use squeal_core::Model;
+
+/// Most bytes the sampled series of one run may take in memory (1 GiB).
+pub const MAX_SERIES_BYTES: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// Most steps a run may need at the least (its [`min_steps`]): beyond this
+/// it would run for many minutes, so it is refused before it starts.
+pub const MAX_MIN_STEPS: f64 = 1.0e8;
+
+/// The model's fastest time scales, from the eigenvalues of its state
+/// matrix at steady sliding and at the initial state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scales {
+    /// Largest eigenvalue modulus |λ| (1/s).
+    pub lambda_max: f64,
+    /// The coordinate dominating that mode ("" if it is a mode at the
+    /// initial state rather than at steady sliding).
+    pub dominant: &'static str,
+    /// Highest mode frequency |Im λ|/2π (Hz).
+    pub f_max_hz: f64,
+}
+
+fn scales_of<M: Model<N> + Inertia, const N: usize>(
+    m: &M,
+    z0: Option<[f64; N]>,
+) -> Result<Option<Scales>, StabilityError> {
+    let mut s: Option<Scales> = None;
+    let mut take = |modulus: f64, im: f64, dominant: &'static str| {
+        let f = im.abs() / (2.0 * std::f64::consts::PI);
+        match &mut s {
+            None => {
+                s = Some(Scales {
+                    lambda_max: modulus,
+                    dominant,
+                    f_max_hz: f,
+                })
+            }
+            Some(s) => {
+                s.f_max_hz = s.f_max_hz.max(f);
+                if modulus > s.lambda_max {
+                    s.lambda_max = modulus;
+                    s.dominant = dominant;
+                }
+            }
+        }
+    };
+    match stability::analyse_with_masses(m, &m.position_masses()) {
+        Ok(an) => {
+            for e in &an.eigen {
+                if !(e.re.is_finite() && e.im.is_finite()) {
+                    return Err(StabilityError::NonFinite {
+                        what: "spectrum (eigenvalues)",
+                    });
+                }
+                take(e.re.hypot(e.im), e.im, e.dominant_name);
+            }
+        }
+        Err(e @ StabilityError::NonFinite { .. }) => return Err(e),
+        Err(_) => {}
+    }
+    if let Some(z) = z0 {
+        let a = m.jacobian(&z);
+        if let Some(ev) = stability::eigen::eigenvalues(&a) {
+            for l in ev {
+                if l.re.is_finite() && l.im.is_finite() {
+                    take(l.re.hypot(l.im), l.im, "");
+                }
+            }
+        }
+    }
+    Ok(s)
+}
+
+/// The fastest time scales of a model (at steady sliding, and at `sc`'s
+/// initial state if given); `None` if neither can be linearised.
+pub fn scales(model: &AnyModel, sc: Option<&Scenario>) -> Result<Option<Scales>, StabilityError> {
+    crate::with_model!(model, m => {
+        let z0 = sc.and_then(|sc| crate::run::initial_of(m, sc).ok());
+        scales_of(m, z0)
+    })
+}
+
+/// The parameters of a model with their values and defaults (the model's
+/// defaults under the same friction law).
+fn params_and_defaults(model: &AnyModel) -> Vec<(&'static str, f64, f64)> {
+    let Some(mut d) = AnyModel::by_name(model.name()) else {
+        return Vec::new();
+    };
+    if let Ok(law) = d.friction().switch_to(model.friction().name()) {
+        d.set_friction(law);
+    }
+    model
+        .param_specs()
+        .iter()
+        .chain(model.friction().params())
+        .filter_map(|p| Some((p.name, model.get(p.name)?, d.get(p.name)?)))
+        .collect()
+}
+
+/// The parameter whose reset to its default makes `bad` smallest (and at
+/// least `gain` times smaller than now): the one to blame.
+fn culprit(
+    model: &AnyModel,
+    gain: f64,
+    bad: impl Fn(&AnyModel) -> f64,
+) -> Option<(&'static str, f64, f64)> {
+    let now = bad(model);
+    let mut best: Option<((&'static str, f64, f64), f64)> = None;
+    for (name, value, default) in params_and_defaults(model) {
+        if value == default {
+            continue;
+        }
+        let mut m = *model;
+        if m.set(name, default).is_err() || m.validate().is_err() {
+            continue;
+        }
+        let b = bad(&m);
+        if b < now && b * gain <= now && best.as_ref().is_none_or(|(_, bb)| b < *bb) {
+            best = Some(((name, value, default), b));
+        }
+    }
+    best.map(|(c, _)| c)
+}
+
+/// A stability failure as a command error. A non-finite state matrix or
+/// equilibrium is bad input (exit 2) naming the parameter that causes it
+/// (the one whose default value makes it finite); see
+/// [`crate::commands::stability::stability_error`] for the rest.
+pub fn stability_failure(model: &AnyModel, e: StabilityError) -> RunError {
+    let StabilityError::NonFinite { what } = e else {
+        return crate::commands::stability::stability_error(e);
+    };
+    let finite = |m: &AnyModel| match scales(m, None) {
+        Err(StabilityError::NonFinite { .. }) => 1.0,
+        _ => 0.0,
+    };
+    let msg = match culprit(model, 1.0, finite) {
+        Some((name, value, default)) => format!(
+            "{name} = {}: the {what} at steady sliding is not finite (it overflows); \
+             with {name} = {} it is",
+            g(value),
+            g(default)
+        ),
+        None => format!(
+            "the {what} at steady sliding is not finite (it overflows): check the parameters for extreme values"
+        ),
+    };
+    RunError::Input(InputError(msg))
+}
+
+/// Check that `sc` can be run, before any work: the series fits in memory,
+/// the sample rate resolves the fastest mode, and the integration needs a
+/// bounded number of steps; then set the run's step budget
+/// (`sc.solver.max_steps`). `what` names the run in messages.
+pub fn prepare(sc: &mut Scenario) -> Result<(), RunError> {
+    sc.validate()?;
+    let rows = sc.duration * sc.sample_rate + 2.0;
+    let cols = (1 + sc.model.state_names().len() + sc.model.derived_columns().len()) as f64;
+    let bytes = rows * cols * 8.0;
+    if bytes > MAX_SERIES_BYTES {
+        return Err(InputError(format!(
+            "sample_rate = {}: {} s at {} Hz is {rows:.3e} samples × {cols} columns = {:.2} GB in memory \
+             (limit {:.2} GB); lower sample_rate or duration",
+            sc.sample_rate,
+            sc.duration,
+            sc.sample_rate,
+            bytes / 1e9,
+            MAX_SERIES_BYTES / 1e9
+        ))
+        .into());
+    }
+    let scales = scales(&sc.model, Some(sc)).map_err(|e| stability_failure(&sc.model, e))?;
+    let lambda = scales.as_ref().map_or(0.0, |s| s.lambda_max);
+    if let Some(s) = &scales {
+        let least = 2.0 * s.f_max_hz;
+        if sc.sample_rate < least {
+            return Err(InputError(format!(
+                "sample_rate = {}: below twice the fastest mode ({:.6e} Hz): the series would alias it; \
+                 the least rate that works is {least:.6e} Hz",
+                sc.sample_rate, s.f_max_hz
+            ))
+            .into());
+        }
+    }
+    // An h_max below the integrator's least step (16 ε · 1e-6 s at t = 0)
+    // fails at once with a step-size underflow and its time: let it.
+    let h_max = if sc.solver.h_max < 16.0 * f64::EPSILON * 1e-6 {
+        f64::INFINITY
+    } else {
+        sc.solver.h_max
+    };
+    let need = min_steps(lambda, sc.duration, h_max);
+    if need > MAX_MIN_STEPS {
+        return Err(RunError::Numerical(stiff_message(
+            sc,
+            scales.as_ref(),
+            need,
+        )));
+    }
+    sc.solver.max_steps = step_budget(need);
+    Ok(())
+}
+
+fn stiff_message(sc: &Scenario, s: Option<&Scales>, need: f64) -> String {
+    let by_h_max = sc.duration / sc.solver.h_max;
+    if by_h_max >= need {
+        return format!(
+            "refused before starting: h_max = {:e} s makes {} s take {need:.2e} steps (limit {MAX_MIN_STEPS:.0e}); \
+             raise h_max or shorten duration",
+            sc.solver.h_max, sc.duration
+        );
+    }
+    let Some(s) = s else {
+        return format!("refused before starting: {need:.2e} steps needed");
+    };
+    let cause = culprit(&sc.model, 10.0, |m| {
+        scales(m, None)
+            .ok()
+            .flatten()
+            .map_or(f64::INFINITY, |s| s.lambda_max)
+    });
+    let (by, fix) = match cause {
+        Some((name, value, default)) => (
+            format!(", set by {name} = {}", g(value)),
+            format!("bring {name} towards {} (its default)", g(default)),
+        ),
+        None => (String::new(), "shorten duration".to_string()),
+    };
+    let mode = if s.dominant.is_empty() {
+        "at the initial state".to_string()
+    } else {
+        format!("({})", s.dominant)
+    };
+    format!(
+        "refused before starting: too stiff for an explicit integrator: the fastest mode {mode} has |λ| = {:.3e} 1/s, \
+         a time scale of {:.3e} s{by}; {} s would take at least {need:.2e} steps (limit {MAX_MIN_STEPS:.0e}); {fix}",
+        s.lambda_max,
+        1.0 / s.lambda_max,
+        sc.duration
+    )
+}
+
+/// A number as people write it: 16.6667, 0.001, 1e15, 1e-300.
+pub fn g(x: f64) -> String {
+    let a = x.abs();
+    let trim = |s: String| {
+        if let Some((m, e)) = s.split_once('e') {
+            let m = if m.contains('.') {
+                m.trim_end_matches('0').trim_end_matches('.')
+            } else {
+                m
+            };
+            format!("{m}e{e}")
+        } else if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    };
+    if x == 0.0 || !x.is_finite() {
+        format!("{x}")
+    } else if (1e-3..1e6).contains(&a) {
+        trim(format!("{:.6}", x))
+    } else {
+        trim(format!("{:.5e}", x))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::g;
+
+    #[test]
+    fn numbers_read_as_written() {
+        assert_eq!(g(1e15), "1e15");
+        assert_eq!(g(50.0 / 3.0), "16.666667");
+        assert_eq!(g(1.0), "1");
+        assert_eq!(g(0.0), "0");
+        assert_eq!(g(1e-300), "1e-300");
+        assert_eq!(g(-2.5e-7), "-2.5e-7");
+    }
+}
