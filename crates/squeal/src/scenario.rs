@@ -554,9 +554,13 @@ impl Scenario {
             .map_err(|e| InputError(e.to_string()))?;
         let samples = self.duration * self.sample_rate;
         if samples > MAX_SAMPLES {
+            let columns = 1 + self.model.state_names().len() + self.model.derived_columns().len();
             return err(format!(
-                "sample_rate = {}: {samples:.3e} samples over {} s exceed the limit of {MAX_SAMPLES:.0e}",
-                self.sample_rate, self.duration
+                "duration = {:e} s at sample_rate = {:e} Hz: {samples:.3e} samples ({:.3e} GB in memory) \
+                 exceed the limit of {MAX_SAMPLES:.0e} samples; lower duration or sample_rate",
+                self.duration,
+                self.sample_rate,
+                samples * columns as f64 * 8.0 / 1e9
             ));
         }
         Ok(())
