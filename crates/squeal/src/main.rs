@@ -12,6 +12,8 @@ mod out;
 mod output;
 mod run;
 mod scenario;
+#[cfg(test)]
+mod scenario_props;
 mod staging;
 
 use clap::{Args, Parser, Subcommand};

@@ -632,10 +632,15 @@ impl Scenario {
         let _ = writeln!(t);
         line(
             &mut t,
-            format!("name = {:?}", self.name),
+            format!("name = {}", toml::Value::String(self.name.clone())),
             "default output folder: out/<name>",
         );
-        let _ = writeln!(t, "description = {:?}", self.description);
+        // TOML's own escaping: Rust's `{:?}` writes `\u{7}`, which TOML cannot read.
+        let _ = writeln!(
+            t,
+            "description = {}",
+            toml::Value::String(self.description.clone())
+        );
         line(
             &mut t,
             format!("model = {:?}", self.model.name()),
