@@ -32,7 +32,7 @@ pub fn min_steps(lambda_max: f64, duration: f64, h_max: f64) -> f64 {
 /// [`BUDGET_FACTOR`] times [`min_steps`]. The factor covers what the bound
 /// leaves out — accuracy (about ten steps per period of the fastest
 /// oscillation), steps cut at events, start-up transients — with a wide
-/// margin: the default disc–pad run takes 8.6 times its bound.
+/// margin: the default disc–pad run takes 9.3 times its bound.
 pub fn step_budget(min_steps: f64) -> u64 {
     let b = BUDGET_BASE + BUDGET_FACTOR * min_steps;
     if b.is_finite() && b < u64::MAX as f64 {
