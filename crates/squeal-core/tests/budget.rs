@@ -61,7 +61,7 @@ fn h_max_and_the_budget_scale_as_documented() {
         1e3 / (STABILITY_REACH / 6.5)
     );
     assert_eq!(step_budget(0.0), 2_000_000);
-    assert_eq!(step_budget(1e4), 3_000_000);
+    assert_eq!(step_budget(1e4), 2_500_000);
     assert_eq!(step_budget(f64::INFINITY), u64::MAX);
     assert_eq!(step_budget(1e300), u64::MAX);
 }

@@ -15,8 +15,11 @@ use squeal_core::Model;
 pub const MAX_SERIES_BYTES: f64 = 1024.0 * 1024.0 * 1024.0;
 
 /// Most steps a run may need at the least (its [`min_steps`]): beyond this
-/// it would run for many minutes, so it is refused before it starts.
-pub const MAX_MIN_STEPS: f64 = 1.0e8;
+/// it would run for minutes (about 1 µs per step, and an accurate run takes
+/// ten times its bound), so it is refused before it starts. The default
+/// disc–pad model reaches it after 300 s of simulated time, beyond its
+/// memory limit.
+pub const MAX_MIN_STEPS: f64 = 1.0e7;
 
 /// The model's fastest time scales, from the eigenvalues of its state
 /// matrix at steady sliding and at the initial state.
