@@ -29,7 +29,10 @@ pub struct ListenArgs {
 
 /// Run the command.
 pub fn run(a: ListenArgs) -> Result<(), RunError> {
-    crate::staging::check_file("--out", &a.out, a.force)?;
+    // Written beside the target and renamed into place: a failure or an
+    // interrupt leaves no partial file, and no file is replaced unasked.
+    // Staged before the work, so an unwritable place is found at once.
+    let staged = crate::staging::StagedFile::new("--out", &a.out, a.force)?;
     let dir = Path::new(&a.scenario.scenario);
     let (run, model) = if dir.is_dir() {
         if !a.scenario.sets.is_empty() {
@@ -63,9 +66,6 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
             vels.join(", ")
         ))
     })?;
-    // Written beside the target and renamed into place: a failure or an
-    // interrupt leaves no partial file, and no file is replaced unasked.
-    let staged = crate::staging::StagedFile::new("--out", &a.out, a.force)?;
     let clip = analysis::write_wav(x, run.sample_rate, staged.path(), a.float)?;
     staged.commit("--out")?;
     if clip.looped {
