@@ -288,21 +288,29 @@ pub fn check_dest_as(flag: &str, dest: &Path) -> Result<(), RunError> {
     if !meta.is_dir() {
         return Err(refuse(flag, dest, "exists and is not a folder"));
     }
-    let entries = walk(dest).map_err(|e| refuse(flag, dest, format!("cannot read it: {e}")))?;
-    if entries.is_empty() {
-        return Ok(());
-    }
     let listed = read_manifest(dest).map_err(|e| refuse(flag, dest, e))?;
     let Some(listed) = listed else {
-        return Err(refuse(
-            flag,
-            dest,
-            format!(
-                "holds '{}' but no {MANIFEST}: not a folder squeal wrote; refusing to replace it",
-                entries[0].rel
-            ),
-        ));
+        // Not squeal's: name its first entry (by name) without descending
+        // into it (it may be a home folder).
+        let cannot = |e: std::io::Error| refuse(flag, dest, format!("cannot read it: {e}"));
+        let mut names = std::fs::read_dir(dest)
+            .map_err(cannot)?
+            .map(|e| e.map(|e| e.file_name().to_string_lossy().into_owned()))
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(cannot)?;
+        names.sort();
+        return match names.first() {
+            None => Ok(()),
+            Some(first) => Err(refuse(
+                flag,
+                dest,
+                format!(
+                    "holds '{first}' but no {MANIFEST}: not a folder squeal wrote; refusing to replace it"
+                ),
+            )),
+        };
     };
+    let entries = walk(dest).map_err(|e| refuse(flag, dest, format!("cannot read it: {e}")))?;
     let owns = |e: &Entry| {
         if e.is_dir {
             let prefix = format!("{}/", e.rel);
@@ -577,9 +585,13 @@ impl Drop for StagedFile {
 /// `staged` holds the new files; each may replace only a file the folder's
 /// manifest lists (or none); the manifest then lists the new ones too.
 pub fn replace_files(dir: &Path, staged: &Path) -> Result<(), RunError> {
-    let listed = read_manifest(dir)
-        .map_err(|e| refuse("run folder", dir, e))?
-        .unwrap_or_default();
+    let manifest = read_manifest(dir).map_err(|e| refuse("run folder", dir, e))?;
+    let why = if manifest.is_some() {
+        "which squeal did not write".to_string()
+    } else {
+        format!("and no {MANIFEST} says squeal wrote it (an older squeal's run? simulate again)")
+    };
+    let listed = manifest.unwrap_or_default();
     let new: Vec<String> = walk(staged)
         .map_err(|e| RunError::Io(format!("cannot list {}: {e}", staged.display())))?
         .into_iter()
@@ -592,7 +604,7 @@ pub fn replace_files(dir: &Path, staged: &Path) -> Result<(), RunError> {
             return Err(refuse(
                 "run folder",
                 dir,
-                format!("holds '{f}', which squeal did not write; refusing to replace it"),
+                format!("holds '{f}', {why}; refusing to replace it"),
             ));
         }
     }

@@ -592,3 +592,33 @@ fn messages_name_the_fix() {
     );
     assert_refused(&o, 2, &["--y", "LO = -5", "k3"]);
 }
+
+#[test]
+fn plot_replaces_only_files_squeal_wrote() {
+    let d = tempfile::tempdir().unwrap();
+    let sim = ["simulate", "--duration", "0.01", "--out", "r", "--no-plots"];
+    assert!(squeal(d.path(), &sim).status.success());
+    // The pictures are new files: plot adds them and lists them.
+    let o = squeal(d.path(), &["plot", "r"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let manifest = std::fs::read_to_string(d.path().join("r/.squeal-manifest.json")).unwrap();
+    assert!(manifest.contains("triplet.png"), "{manifest}");
+    assert!(squeal(d.path(), &["plot", "r", "--window", "flattop"])
+        .status
+        .success());
+    // A user's picture where plot would write one is not replaced.
+    assert!(squeal(
+        d.path(),
+        &["simulate", "--duration", "0.01", "--out", "s", "--no-plots"]
+    )
+    .status
+    .success());
+    std::fs::write(d.path().join("s/phase.png"), "my drawing").unwrap();
+    let o = squeal(d.path(), &["plot", "s"]);
+    assert_refused(&o, 2, &["phase.png"]);
+    assert_eq!(
+        std::fs::read_to_string(d.path().join("s/phase.png")).unwrap(),
+        "my drawing"
+    );
+    assert!(leftovers(d.path()).is_empty(), "{:?}", leftovers(d.path()));
+}
