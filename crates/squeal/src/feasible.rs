@@ -282,7 +282,35 @@ pub fn g(x: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::g;
+    use super::*;
+
+    #[test]
+    fn the_budget_follows_from_the_fastest_mode() {
+        // The default brake's fastest mode: λ = −1.145469 ± 2.162192e5 i 1/s
+        // (34 412.35 Hz, README), over 0.5 s.
+        let mut sc = Scenario::builtin("disc-pad").unwrap();
+        prepare(&mut sc).unwrap();
+        let bound = 0.5 * 2.162192e5_f64.hypot(1.145469) / 6.5;
+        let ratio = sc.solver.max_steps as f64 / step_budget(bound) as f64;
+        assert!((ratio - 1.0).abs() < 1e-6, "{ratio}");
+        // Ten times the duration, ten times the bound.
+        let mut long = Scenario::builtin("disc-pad").unwrap();
+        long.duration = 5.0;
+        prepare(&mut long).unwrap();
+        let ratio = long.solver.max_steps as f64 / step_budget(10.0 * bound) as f64;
+        assert!((ratio - 1.0).abs() < 1e-6, "{ratio}");
+    }
+
+    #[test]
+    fn an_exhausted_budget_says_when_and_why() {
+        let e = squeal_core::IntegrateError::MaxSteps {
+            t: 0.25,
+            steps: 1000,
+        };
+        let msg = crate::run::explain(e, 0.5);
+        assert!(msg.contains("t = 2.5") && msg.contains("1000 steps") && msg.contains("stiff"));
+        assert!(msg.contains("mean step 2.500e-4 s"), "{msg}");
+    }
 
     #[test]
     fn numbers_read_as_written() {

@@ -50,7 +50,11 @@ pub fn install_signal_handlers() {
                 remove_partial(p);
             }
             let name = if sig == SIGINT { "SIGINT" } else { "SIGTERM" };
-            eprintln!("interrupted ({name}): partial output removed");
+            if live.is_empty() {
+                eprintln!("interrupted ({name})");
+            } else {
+                eprintln!("interrupted ({name}): partial output removed");
+            }
             std::process::exit(128 + sig);
         }
     });

@@ -399,7 +399,12 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-map", sc.name)));
-    let stage = Staging::new(&dest)?;
+    let flag = if a.out.is_some() {
+        "--out"
+    } else {
+        "output folder (default --out)"
+    };
+    let stage = Staging::new_as(flag, &dest)?;
     let n = x.values.len() * y.values.len();
     let pb = progress_bar(n as u64, "eigen-analysis");
     let lin = linear_grid(&sc.model, &x, &y, &pb)?;

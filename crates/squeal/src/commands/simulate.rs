@@ -103,7 +103,12 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
-    let stage = Staging::new(&dest)?;
+    let flag = if a.out.is_some() {
+        "--out"
+    } else {
+        "output folder (default --out)"
+    };
+    let stage = Staging::new_as(flag, &dest)?;
     let run = run::run(&sc)?;
     let t0 = Instant::now();
     if csv {
