@@ -6,6 +6,9 @@ use squeal_core::EventKind;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
+/// Largest series file `read_run_dir` reads (4 GB).
+pub const MAX_SERIES_FILE: u64 = 4_000_000_000;
+
 fn io_err(path: &Path, e: std::io::Error) -> RunError {
     RunError::Io(format!("cannot write {}: {e}", path.display()))
 }
@@ -192,6 +195,20 @@ pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
         })?;
     let csv = dir.join("series.csv");
     let npy = dir.join("series.npy");
+    // Read whole: refuse what squeal could not have written (its series
+    // stay below 1 GiB in memory, ~3 GB as text) before reading it.
+    for p in [&csv, &npy] {
+        if let Ok(m) = std::fs::metadata(p) {
+            if m.len() > MAX_SERIES_FILE {
+                return Err(bad(format!(
+                    "{}: {:.2} GB is larger than any series squeal writes ({:.0} GB at most)",
+                    p.display(),
+                    m.len() as f64 / 1e9,
+                    MAX_SERIES_FILE as f64 / 1e9
+                )));
+            }
+        }
+    }
     let (columns, data) = if csv.is_file() {
         let text = std::fs::read_to_string(&csv)
             .map_err(|e| bad(format!("{}: cannot read: {e}", csv.display())))?;

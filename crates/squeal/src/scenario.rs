@@ -23,6 +23,9 @@ fn err<T>(msg: impl Into<String>) -> Result<T, InputError> {
     Err(InputError(msg.into()))
 }
 
+/// Largest scenario file read (1 MiB).
+pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
+
 /// Most samples a run may write (guards memory against a typo in `sample_rate`).
 pub const MAX_SAMPLES: f64 = 5.0e7;
 
@@ -187,8 +190,24 @@ impl Scenario {
     pub fn load(spec: &str) -> Result<Scenario, InputError> {
         let path = Path::new(spec);
         if path.is_file() || spec.ends_with(".toml") {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| InputError(format!("scenario file {spec}: cannot read: {e}")))?;
+            // A scenario is a few kB; reading stops at 1 MiB (a device or a
+            // wrong file is not read for ever).
+            let mut text = String::new();
+            std::io::Read::read_to_string(
+                &mut std::io::Read::take(
+                    std::fs::File::open(path).map_err(|e| {
+                        InputError(format!("scenario file {spec}: cannot read: {e}"))
+                    })?,
+                    MAX_SCENARIO_BYTES + 1,
+                ),
+                &mut text,
+            )
+            .map_err(|e| InputError(format!("scenario file {spec}: cannot read: {e}")))?;
+            if text.len() as u64 > MAX_SCENARIO_BYTES {
+                return err(format!(
+                    "scenario file {spec}: larger than 1 MiB; not a scenario"
+                ));
+            }
             let mut sc =
                 Scenario::from_toml(&text).map_err(|e| InputError(format!("{spec}: {}", e.0)))?;
             // A file without a `name` is named after itself (out/<file stem>).
