@@ -612,13 +612,18 @@ pub fn replace_files(dir: &Path, staged: &Path) -> Result<(), RunError> {
             ));
         }
     }
+    // The manifest first, then the files, under the lock the signal handler
+    // takes: an interrupt waits, and a crash midway leaves no file of
+    // squeal's unlisted (which would block the next run).
+    let _live = live();
+    let mut all = listed;
+    all.extend(new.iter().cloned());
+    write_listed(dir, &all)?;
     for f in &new {
         std::fs::rename(staged.join(f), dir.join(f))
             .map_err(|e| RunError::Io(format!("cannot write {}: {e}", dir.join(f).display())))?;
     }
-    let mut all = listed;
-    all.extend(new);
-    write_listed(dir, &all)
+    Ok(())
 }
 
 /// Write `dir`'s manifest listing exactly `files`.
