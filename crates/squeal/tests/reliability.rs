@@ -341,6 +341,11 @@ fn extreme_parameters_end_within_seconds_naming_the_cause() {
             "{args:?}: {err}"
         );
         assert!(err.contains("time scale") && err.contains("steps"), "{err}");
+        // The parameter ratio behind the time scale, e.g. |λ| ∝ c_dx^1 · m_d^-1.
+        assert!(
+            err.contains(&format!("{param}^")) && err.contains("∝"),
+            "{err}"
+        );
     }
     assert!(!d.path().join("out").exists(), "nothing written");
 }
