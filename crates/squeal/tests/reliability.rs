@@ -371,6 +371,12 @@ fn non_finite_linearisations_are_errors_that_end() {
         assert_refused(&o, 2, &["Uc", "not finite"]);
     }
     assert!(!d.path().join("m").exists());
+    // A scan that would not end in a lifetime is refused.
+    let o = squeal(
+        d.path(),
+        &["critical", "--param", "c_dx=0:10", "--grid", "100000000000"],
+    );
+    assert_refused(&o, 2, &["--grid"]);
 }
 
 #[test]
