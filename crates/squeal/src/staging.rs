@@ -433,7 +433,19 @@ impl Staging {
                 self.dest.display()
             ))
         };
-        if std::fs::symlink_metadata(&self.dest).is_ok() {
+        let mut exists = std::fs::symlink_metadata(&self.dest).is_ok();
+        if !exists {
+            match rename_noreplace(&self.tmp, &self.dest) {
+                Ok(()) => {}
+                // Another run put it there meanwhile: check it, then swap.
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    check_dest_as(&self.flag, &self.dest)?;
+                    exists = true;
+                }
+                Err(e) => return Err(io(e)),
+            }
+        }
+        if exists {
             if exchange(&self.tmp, &self.dest).map_err(io)? {
                 // The old output is now at the staging name.
                 remove_owned(&self.tmp);
@@ -446,8 +458,6 @@ impl Staging {
                 }
                 remove_owned(&old);
             }
-        } else {
-            rename_noreplace(&self.tmp, &self.dest).map_err(io)?;
         }
         live.retain(|p| p != &self.tmp);
         self.done = true;

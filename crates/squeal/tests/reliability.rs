@@ -641,3 +641,42 @@ fn plot_replaces_only_files_squeal_wrote() {
     );
     assert!(leftovers(d.path()).is_empty(), "{:?}", leftovers(d.path()));
 }
+
+/// Concurrent writers to one destination: every run succeeds, the last
+/// swap wins, and nothing is left behind.
+#[test]
+fn concurrent_runs_into_one_folder_all_succeed() {
+    let d = tempfile::tempdir().unwrap();
+    let children: Vec<Child> = (0..4)
+        .map(|_| {
+            Command::new(BIN)
+                .current_dir(d.path())
+                .args([
+                    "simulate",
+                    "--duration",
+                    "0.005",
+                    "--out",
+                    "same",
+                    "--no-plots",
+                ])
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    for c in children {
+        let o = c.wait_with_output().unwrap();
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    let manifest = std::fs::read_to_string(d.path().join("same/.squeal-manifest.json")).unwrap();
+    assert!(manifest.contains("series.csv"));
+    assert_eq!(
+        std::fs::read_to_string(d.path().join("same/series.csv"))
+            .unwrap()
+            .lines()
+            .count(),
+        1 + 1001
+    );
+    assert!(leftovers(d.path()).is_empty(), "{:?}", leftovers(d.path()));
+}
