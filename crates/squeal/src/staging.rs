@@ -154,11 +154,18 @@ fn remove_owned(p: &Path) {
         let _ = std::fs::remove_file(p);
         return;
     }
-    let Ok(Some(files)) = read_manifest(p) else {
-        remove_partial(p);
-        return;
+    let files = match read_manifest(p) {
+        Ok(Some(files)) => files,
+        Ok(None) => {
+            remove_partial(p);
+            return;
+        }
+        Err(e) => {
+            eprintln!("note: {} left in place: {e}", p.display());
+            return;
+        }
     };
-    for f in &files {
+    for f in files.iter().filter(|f| no_link_on_the_way(p, f)) {
         let _ = std::fs::remove_file(p.join(f));
     }
     let _ = std::fs::remove_file(p.join(MANIFEST));
@@ -178,6 +185,21 @@ fn remove_owned(p: &Path) {
             p.display()
         );
     }
+}
+
+/// Whether `root/rel` is reached without passing through a symbolic link
+/// (so that removing it cannot touch anything outside `root`).
+fn no_link_on_the_way(root: &Path, rel: &str) -> bool {
+    let mut cur = root.to_path_buf();
+    let parts: Vec<&str> = rel.split('/').collect();
+    for part in &parts[..parts.len().saturating_sub(1)] {
+        cur.push(part);
+        match std::fs::symlink_metadata(&cur) {
+            Ok(m) if m.is_dir() => {}
+            _ => return false,
+        }
+    }
+    true
 }
 
 /// One entry of a folder tree, relative to its root ('/'-separated).
@@ -668,6 +690,23 @@ mod tests {
         assert_eq!(stage_pid(".squeal-manifest.json"), None);
         assert_eq!(stage_pid(".squeal-12-0123.new"), None);
         assert!(alive(std::process::id()));
+    }
+
+    #[test]
+    fn removal_never_follows_a_link_out_of_the_folder() {
+        let d = tempfile::tempdir().unwrap();
+        let outside = d.path().join("outside");
+        std::fs::create_dir(&outside).unwrap();
+        std::fs::write(outside.join("a.png"), "precious").unwrap();
+        let stale = d.path().join(".squeal-1-0123456789abcdef.old");
+        std::fs::create_dir(&stale).unwrap();
+        std::os::unix::fs::symlink(&outside, stale.join("figures")).unwrap();
+        std::fs::write(stale.join("b.csv"), "x").unwrap();
+        write_listed(&stale, &["figures/a.png".into(), "b.csv".into()]).unwrap();
+        assert!(!no_link_on_the_way(&stale, "figures/a.png"));
+        remove_owned(&stale);
+        assert!(outside.join("a.png").is_file());
+        assert!(!stale.join("b.csv").exists());
     }
 
     #[test]
