@@ -545,21 +545,34 @@ fn reproduce_twice_gives_byte_identical_reports() {
     for out in ["a", "b"] {
         let o = squeal(
             d.path(),
-            &[
-                "reproduce",
-                "--out",
-                out,
-                "--duration-scale",
-                "0.05",
-                "--no-figures",
-            ],
+            &["reproduce", "--out", out, "--duration-scale", "0.05"],
         );
         assert!(o.status.success(), "{}", stderr(&o));
     }
+    // Every file, figures included, byte for byte.
+    fn files(root: &Path, dir: &Path, out: &mut Vec<std::path::PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                files(root, &p, out);
+            } else {
+                out.push(p.strip_prefix(root).unwrap().to_path_buf());
+            }
+        }
+    }
+    let (mut fa, mut fb) = (Vec::new(), Vec::new());
+    files(&d.path().join("a"), &d.path().join("a"), &mut fa);
+    files(&d.path().join("b"), &d.path().join("b"), &mut fb);
+    fa.sort();
+    fb.sort();
+    assert_eq!(fa, fb);
     for f in ["report.md", "report.html", "table.csv", "conclusions.json"] {
+        assert!(fa.contains(&f.into()), "{f} missing");
+    }
+    for f in &fa {
         let a = std::fs::read(d.path().join("a").join(f)).unwrap();
         let b = std::fs::read(d.path().join("b").join(f)).unwrap();
-        assert!(a == b, "{f} differs between two identical runs");
+        assert!(a == b, "{} differs between two identical runs", f.display());
     }
 }
 
