@@ -402,6 +402,24 @@ fn every_simulating_command_is_validated_the_same_way() {
     }
     // What the refusal says is the same, whichever command.
     assert_eq!(stderr(&sim), stderr(&map));
+    // Within the sample limit but beyond memory: refused with the size.
+    let sim = squeal(d.path(), &["simulate", "--duration", "60"]);
+    let map = squeal(
+        d.path(),
+        &[
+            "map",
+            "--x",
+            "N=100:200:2",
+            "--y",
+            "V=1:2:2",
+            "--transient",
+            "--duration",
+            "60",
+        ],
+    );
+    for o in [&sim, &map] {
+        assert_refused(o, 2, &["sample_rate", "1.25 GB in memory", "limit"]);
+    }
     assert!(!d.path().join("out").exists());
 }
 
