@@ -1,5 +1,5 @@
-//! Running a scenario: integrate, collect columns, and stage outputs in a
-//! temporary folder that is renamed into place only when complete.
+//! Running a scenario: integrate and collect columns and events (outputs
+//! are staged by [`crate::staging::Staging`], re-exported here).
 
 use crate::model::AnyModel;
 use crate::scenario::{InputError, Scenario};
