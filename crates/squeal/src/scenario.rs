@@ -568,6 +568,10 @@ impl Scenario {
             t,
             "# (offsets as --set x_d0=1e-9, solver keys as --set rtol=1e-10)."
         );
+        let _ = writeln!(
+            t,
+            "# The equations, friction laws and the origin of every default: docs/physics.md"
+        );
         let _ = writeln!(t);
         line(
             &mut t,
