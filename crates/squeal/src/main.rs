@@ -10,6 +10,7 @@ mod model;
 mod output;
 mod run;
 mod scenario;
+mod study;
 
 use clap::{Args, Parser, Subcommand};
 use run::RunError;

@@ -21,12 +21,14 @@
 //! - [`max_growth_rate`]: the fast path for stability maps (eigenvalues only,
 //!   no heap allocation, ≈ 2 µs for the 8-state disc–pad model);
 //! - [`critical`]: a grid scan plus Brent's method for the parameter value
-//!   at which the stability changes.
+//!   at which the stability changes;
+//! - [`track`]: eigenvalues followed along a parameter path.
 //!
 //! The eigen-solver is [`eigen`] (balancing + Hessenberg + Francis QR, with
 //! the reasons it is hand-written).
 
 pub mod eigen;
+pub mod track;
 
 use crate::model::{Model, ModelError};
 use crate::params::ParamError;
