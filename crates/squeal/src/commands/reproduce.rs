@@ -337,6 +337,8 @@ struct Conclusion {
     /// One line for the headline: why this grade.
     caveat: String,
     evidence: String,
+    /// The evidence's numbers, machine-readable (conclusions.json `data`).
+    data: Value,
 }
 
 /// The sets of `v` for which `keep` holds.
@@ -357,9 +359,9 @@ fn db(x: f64) -> f64 {
     20.0 * x.max(1e-300).log10()
 }
 
-/// Verdicts that mean a sustained or growing friction-excited vibration.
+/// A run squeals when its vibration grows or is sustained by friction.
 fn squeals(r: &SetResult) -> bool {
-    matches!(r.verdict.as_str(), "grows" | "stick-slip" | "limit-cycle")
+    matches!(r.verdict.as_str(), "grows" | "stick-slip")
 }
 
 /// Follower-force sweep: negative α values (log-spaced −1 … −1e5) and positive ones.
@@ -542,6 +544,7 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
     let ok1 =
         !no_stribeck.is_empty() && bad.is_empty() && elsewhere.is_empty() && !squealing.is_empty();
     out.push(Conclusion {
+        data: Value::Null,
         id: 1,
         thesis: "Unstable tangential oscillations develop through the Stribeck effect.",
         claim: "The Stribeck effect is necessary, not sufficient: no sliding run without it (f1 = 0) has a growing mode or squeals, and every run that squeals has f1 > 0 and V < Uc; with it, a run squeals only where its damping is below the critical damping.".into(),
@@ -569,6 +572,7 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
     let (np_lo, np_hi) = minmax(&|r| r.nor_prom_at_ft);
     let ok2 = !a0.is_empty() && present.len() == a0.len() && leak.is_empty();
     out.push(Conclusion {
+        data: Value::Null,
         id: 2,
         thesis: "Normal oscillations show up in the tangential spectrum through F_y; not the other way round (without follower force).",
         claim: "In every sliding run with α = 0 the tangential velocity spectrum has a peak (≥ 10 dB above its neighbourhood) at the disc's normal frequency, while the normal spectrum has none (≤ 3 dB) at the disc's tangential frequency.".into(),
@@ -593,6 +597,13 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
         && k.last_event.is_none_or(|t| t < 0.5 * k.duration);
     let rate = |x: Option<f64>| x.map_or("n/a".into(), |r| format!("{r:+.3}"));
     out.push(Conclusion {
+        data: json!({
+            "sets_above_uc_squealing": above_bad.iter().map(|r| r.id).collect::<Vec<_>>(),
+            "sweep_points": npts, "sweep_max_growth_rate": smax,
+            "kick": {"V": k.v, "vx_p0": k.kick.0, "vx_d0": k.kick.1, "reversals": k.reversals, "sticks": k.sticks,
+                     "last_event_s": k.last_event, "disc_rate": k.rate.0, "pad_rate": k.rate.1,
+                     "disc_sigma": k.sigma.0, "pad_sigma": k.sigma.1, "verdict": sw.kicked_verdict},
+        }),
         id: 3,
         thesis: "No tangential instability above the critical speed Uc.",
         claim: format!("No run with V > Uc = {uc:.2} m/s grows or squeals; an eigenvalue sweep of V over (Uc, 3Uc] at N = 100–5000 N without tangential damping finds no growing mode; and a large kick above Uc (pad and disc thrown far past the disc speed, so that the slip reverses) dies away too."),
@@ -618,6 +629,13 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
     let f0 = rs[14].p("f0");
     let f1 = rs[14].p("f1");
     out.push(Conclusion {
+        data: json!({
+            "thesis_estimate_kg_s": [30.0, 100.0],
+            "thesis_formula_N_f1_kg_s": [500.0 * f1, 2000.0 * f1],
+            "destabilising_term_kg_s": {"N500_V1": d500, "N2000_V1": d2000},
+            "missing_factor_f0": f0,
+            "critical_damping_kg_s": {"N500": c500, "N2000": c2000},
+        }),
         id: 4,
         thesis: "Below Uc, instability appears when damping is small, more readily at high N.",
         claim: "At V = 1 m/s the tangential damping needed to silence the brake (c = c_dx = c_px) rises with the pad force, and the damping that silences it at N = 500 N (set 28) does not at N = 2000 N (set 31). The thesis's size of the destabilising term, 30–100 kg/s, is confronted with the model's.".into(),
@@ -692,6 +710,18 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
     let by_reversal = reversals > 10 * sticks;
     let ok5 = !saturated.is_empty() && bounded.len() == saturated.len();
     out.push(Conclusion {
+        data: json!({
+            "sticks": sticks, "reversals": reversals,
+            "stick_window_m": window,
+            "sets": saturated.iter().map(|r| json!({
+                "set": r.id, "sticks": r.stick.sticks, "reversals": r.stick.reversals,
+                "sticks_per_s": r.stick.sticks as f64 / r.sc.duration,
+                "reversals_per_s": r.stick.reversals as f64 / r.sc.duration,
+                "stick_duration_s": r.stick.durations.map(|d| json!({"median": d.0, "min": d.1, "max": d.2})),
+            })).collect::<Vec<_>>(),
+            "thesis_flag_stick_slip_sets": flagged.iter().map(|r| r.id).collect::<Vec<_>>(),
+            "thesis_flag_sets_without_true_stick": flagged_no_stick.iter().map(|r| r.id).collect::<Vec<_>>(),
+        }),
         id: 5,
         thesis: "Stick-slip limits the amplitude of the growing oscillation.",
         claim: "Every linearly unstable run without follower force that reaches the disc speed in the first 60 % of its duration settles on a bounded friction-limited cycle (pad speed below 2V) instead of growing without bound; the events say whether true sticks or slip reversals limit it.".into(),
@@ -778,6 +808,14 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
         );
     }
     out.push(Conclusion {
+        data: json!({
+            "c_px_star": cp.c_star,
+            "disc_eigenvalue_max_relative_change": cp.disc_eig_change,
+            "sweep": cp.points.iter().map(|p| json!({
+                "c_px": p.c_px, "sigma_pad": p.sigma_pad, "sigma_disc": p.sigma_disc,
+                "saturated_at_s": p.saturated_at, "reversals": p.reversals, "disc_envelope_rate": p.disc_rate,
+            })).collect::<Vec<_>>(),
+        }),
         id: 6,
         thesis: "The pad, which grows faster (smaller inertia), reaches stick-slip first, and its stick-slip suppresses the disc's growth; adding pad damping can destabilise the disc.",
         claim: "In the default brake the pad's mode grows faster than the disc's and reaches reversals first; across a sweep of c_px through the pad's Hopf damping c_px*, the disc collapses wherever the pad saturates and grows at its eigenvalue rate (within 10 %) wherever the pad stays linear, while the disc's eigenvalue does not change with c_px.".into(),
@@ -879,6 +917,17 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
         }
     };
     out.push(Conclusion {
+        data: sw.alpha.as_ref().map_or(Value::Null, |a| json!({
+            "alpha_values_negative": a.n_neg, "alpha_values_positive": a.n_pos,
+            "alpha_end": a.alpha_end, "steady_sliding_limit": a.limit,
+            "closest_modes": {"a": a.closest.0, "b": a.closest.1, "relative_distance": a.closest.2, "alpha": a.closest.3},
+            "modes": a.modes.iter().map(|m| json!({
+                "mode": m.name, "freq_hz": m.freq0, "sigma": m.sigma0,
+                "sigma_1pct_abs_alpha": m.sigma_at[0], "sigma_10pct_abs_alpha": m.sigma_at[1],
+                "freq_1pct_abs_alpha": m.freq_at[0], "freq_10pct_abs_alpha": m.freq_at[1],
+                "sigma_1pct_positive_alpha": m.sigma_at_pos[0], "freq_1pct_positive_alpha": m.freq_at_pos[0],
+            })).collect::<Vec<_>>(),
+        })),
         id: 7,
         thesis: "The follower force, at realistic α, is too weak to couple tangential and normal motion.",
         claim: claim7,
@@ -1636,7 +1685,7 @@ pub fn run(a: ReproduceArgs) -> Result<(), RunError> {
     write("table.csv", &table_csv(&rs))?;
     let cj: Vec<Value> = cs
         .iter()
-        .map(|c| json!({ "id": c.id, "thesis": c.thesis, "claim": c.claim, "held": c.grade.held(), "grade": c.grade.as_str(), "caveat": c.caveat, "evidence": c.evidence }))
+        .map(|c| json!({ "id": c.id, "thesis": c.thesis, "claim": c.claim, "held": c.grade.held(), "grade": c.grade.as_str(), "caveat": c.caveat, "evidence": c.evidence, "data": c.data }))
         .collect();
     write(
         "conclusions.json",
