@@ -6,13 +6,13 @@ use crate::model::Channels;
 use crate::run::{Run, RunError};
 use crate::scenario::InputError;
 use serde_json::{json, Map, Value};
-use squeal_core::EventKind;
 use squeal_plot::{Format, HeatmapSpec, Labels, Panel, Series};
 use squeal_signal::spectrum::Scaling;
 use squeal_signal::window::Window;
 use squeal_signal::{
-    amplitude_spectrum, find_peaks, growth_rate_linear_part, spectrogram, welch, GrowthOptions,
-    Peak, PeakOptions, Spectrum, Verdict, VerdictOptions, WelchOptions,
+    amplitude_spectrum, find_peaks, growth_rate_linear_part, spectrogram, welch, Coordinate,
+    EventClass, GrowthOptions, JudgeOptions, Judgement, Peak, PeakOptions, RunEvent, RunRecord,
+    RunVerdict, Spectrum, WelchOptions,
 };
 use std::fmt::Write as _;
 use std::path::Path;
@@ -47,8 +47,10 @@ pub struct Analysis {
     pub normal: Option<ChannelSpectrum>,
     /// Growth rate of each velocity over its exponential part: (signal, rate 1/s, t0, t1, R²).
     pub growth: Vec<(String, f64, f64, f64, f64)>,
-    /// One word: decays, grows, limit-cycle, stick-slip.
-    pub verdict: Verdict,
+    /// The run's word ([`RunVerdict`]); the same as `judgement.verdict`.
+    pub verdict: RunVerdict,
+    /// The verdict with its reasons, trends, squeal answer and events per cycle.
+    pub judgement: Judgement,
 }
 
 /// The spectral analyser's settings (the thesis's analyser had a sample time,
@@ -139,7 +141,9 @@ fn spectrum_of(name: &str, x: &[f64], fs: f64, set: &SpectrumSettings) -> Option
 }
 
 /// Analyse a run. Velocities are the columns whose names start with `v`.
-pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
+///
+/// `validity` is the scenario's displacement bound (m) for `out-of-range`.
+pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings, validity: f64) -> Analysis {
     let fs = run.sample_rate;
     let tangential = run
         .column(ch.tangential)
@@ -147,16 +151,6 @@ pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
     let normal = ch
         .normal
         .and_then(|n| run.column(n).and_then(|x| spectrum_of(n, x, fs, set)));
-    let t_end = run
-        .column("t")
-        .and_then(|t| t.last().copied())
-        .unwrap_or(0.0);
-    let tail_start = 0.75 * t_end;
-    let stick_slip_in_tail = run
-        .events
-        .iter()
-        .any(|(t, k)| *t >= tail_start && matches!(k, EventKind::Stick | EventKind::Reverse));
-    let stick_flag = if stick_slip_in_tail { 1.0 } else { 0.0 };
     let mut growth = Vec::new();
     for (name, col) in run.columns.iter().zip(&run.data) {
         if !name.starts_with('v') || name == "v_rel" {
@@ -174,62 +168,92 @@ pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
             }
         }
     }
-    // The verdict is about the friction-excited (tangential) motion; only when
-    // there is none (a disc at rest) does it describe the normal motion; when
-    // nothing moves by more than STILL·V (a run started exactly at a stable
-    // equilibrium, where only integration noise remains) it decays. A
-    // steady tail is one whose level changes by less than 0.25 dB: slow decays
-    // (the disc's ≈ 0.5 1/s) must not pass for limit cycles.
-    let opts = VerdictOptions {
-        steady_tol_db: 0.25,
-        ..VerdictOptions::default()
-    };
-    let speed = run
-        .column("v_rel")
-        .map_or(0.0, |v| v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
-    let still = STILL * speed.max(1e-3);
-    let moving = |name: &str| {
-        run.column(name)
-            .is_some_and(|x| x.iter().any(|v| v.abs() > still))
-    };
-    let velocity = |name: &str| name.starts_with('v') && name != "v_rel";
-    let tangential_cols: Vec<&String> = run
-        .columns
-        .iter()
-        .filter(|n| velocity(n) && (n.starts_with("vx") || n.as_str() == "v") && moving(n))
-        .collect();
-    let chosen: Vec<&String> = if tangential_cols.is_empty() {
-        run.columns
-            .iter()
-            .filter(|n| velocity(n) && moving(n))
-            .collect()
-    } else {
-        tangential_cols
-    };
-    let verdicts: Vec<Verdict> = chosen
-        .iter()
-        .filter_map(|n| run.column(n))
-        .filter_map(|x| squeal_signal::classify_with(x, fs, stick_flag, &opts).ok())
-        .map(|c| c.verdict)
-        .collect();
-    // The system's verdict: growing anywhere beats a steady oscillation, which beats decay.
-    let verdict = if verdicts.contains(&Verdict::Grows) {
-        Verdict::Grows
-    } else if verdicts.contains(&Verdict::StickSlip)
-        || (stick_slip_in_tail && verdicts.contains(&Verdict::LimitCycle))
-    {
-        Verdict::StickSlip
-    } else if verdicts.contains(&Verdict::LimitCycle) {
-        Verdict::LimitCycle
-    } else {
-        Verdict::Decays
-    };
+    let judgement = judge_run(run, validity);
+    let verdict = judgement.verdict;
     Analysis {
         tangential,
         normal,
         growth,
         verdict,
+        judgement,
     }
+}
+
+/// The state's coordinates of a run by name: every column `q` with a velocity
+/// column `vq` (`x_p` and `vx_p`; the belt's `x` has `v`), in column order.
+pub fn state_pairs(run: &Run) -> Vec<(String, String)> {
+    let has = |n: &str| run.columns.iter().any(|c| c == n);
+    run.columns
+        .iter()
+        .skip(1)
+        .filter_map(|c| {
+            let v = format!("v{c}");
+            if has(&v) {
+                Some((c.clone(), v))
+            } else if c == "x" && has("v") {
+                Some((c.clone(), "v".to_string()))
+            } else {
+                None
+            }
+        })
+        .collect()
+}
+
+/// The run's events as the verdict sees them.
+pub fn run_events(run: &Run) -> Vec<RunEvent<'static>> {
+    run.events
+        .iter()
+        .filter_map(|(t, k)| {
+            EventClass::from_name(k.as_str()).map(|kind| RunEvent {
+                t: *t,
+                kind,
+                contact: None,
+            })
+        })
+        .collect()
+}
+
+/// [`squeal_signal::judge`] on a run: every coordinate, every event, the
+/// scenario's validity bound; the velocity scale is the largest sliding speed.
+pub fn judge_run(run: &Run, validity: f64) -> Judgement {
+    let pairs = state_pairs(run);
+    let coordinates: Vec<Coordinate> = pairs
+        .iter()
+        .filter_map(|(p, v)| {
+            Some(Coordinate {
+                name: p,
+                velocity_name: v,
+                position: run.column(p)?,
+                velocity: run.column(v)?,
+            })
+        })
+        .collect();
+    let speed = run
+        .column("v_rel")
+        .map_or(0.0, |v| v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+    let record = RunRecord {
+        sample_rate: run.sample_rate,
+        t_start: run
+            .column("t")
+            .and_then(|t| t.first().copied())
+            .unwrap_or(0.0),
+        coordinates,
+        events: run_events(run),
+        velocity_scale: speed,
+    };
+    let opts = JudgeOptions {
+        validity,
+        still: STILL,
+        ..JudgeOptions::default()
+    };
+    squeal_signal::judge(&record, &opts).unwrap_or_else(|e| Judgement {
+        verdict: RunVerdict::TooShort,
+        reason: e.to_string(),
+        window: (0.0, 0.0),
+        trends: Vec::new(),
+        squeal: None,
+        cycle: None,
+    })
 }
 
 fn channel_json(c: &Option<ChannelSpectrum>) -> Value {
@@ -276,6 +300,90 @@ impl Analysis {
             obj.insert("growth_rate".into(), json!(g));
         }
         v
+    }
+
+    /// The `squeal` key of summary.json: `{coordinate, frequency_hz, rms,
+    /// level_db}` (position name, Hz, velocity RMS in m/s over the judged
+    /// window, dB re 1 m/s), or `null` when nothing squeals.
+    pub fn squeal_json(&self) -> Value {
+        match &self.judgement.squeal {
+            None => Value::Null,
+            Some(s) => json!({
+                "coordinate": s.coordinate,
+                "velocity": s.velocity,
+                "frequency_hz": s.frequency_hz,
+                "rms": s.rms,
+                "level_db": s.level_db,
+            }),
+        }
+    }
+
+    /// The `verdict_detail` key of summary.json: why the verdict, over which
+    /// window, and (when the run squeals) its events per cycle: true sticks,
+    /// slip reversals, separations.
+    pub fn verdict_detail_json(&self) -> Value {
+        let j = &self.judgement;
+        let trends: Map<String, Value> = j
+            .trends
+            .iter()
+            .map(|t| {
+                (
+                    t.name.clone(),
+                    json!({
+                        "rms": t.rms,
+                        "rate": if t.rate_se.is_finite() { json!(t.rate) } else { Value::Null },
+                        "rate_se": if t.rate_se.is_finite() { json!(t.rate_se) } else { Value::Null },
+                        "change_db": if t.rate_se.is_finite() { json!(t.change_db) } else { Value::Null },
+                        "below_peak_db": t.below_peak_db,
+                        "moving": t.moving,
+                    }),
+                )
+            })
+            .collect();
+        let cycle = j.cycle.map_or(Value::Null, |c| {
+            json!({
+                "cycles": c.cycles,
+                "sticks": c.sticks,
+                "reversals": c.reversals,
+                "separations": c.separations,
+                "sticks_per_cycle": c.sticks_per_cycle,
+                "reversals_per_cycle": c.reversals_per_cycle,
+                "separations_per_cycle": c.separations_per_cycle,
+            })
+        });
+        json!({
+            "verdict": j.verdict.as_str(),
+            "reason": j.reason,
+            "window_s": [j.window.0, j.window.1],
+            "per_cycle": cycle,
+            "trends": trends,
+        })
+    }
+
+    /// The squeal answer in words, for the terminal: "squeals at 20.75 kHz
+    /// (x_p, vx_p RMS 0.708 m/s = −3.0 dB re 1 m/s)", or what the verdict says
+    /// instead.
+    pub fn squeal_line(&self, coordinate_words: impl Fn(&str) -> Option<&'static str>) -> String {
+        let j = &self.judgement;
+        match &j.squeal {
+            Some(s) => {
+                let what = coordinate_words(&s.coordinate)
+                    .map_or(s.coordinate.clone(), |w| format!("{w}, {}", s.coordinate));
+                let verb = if j.verdict == RunVerdict::Grows {
+                    "squeals (still growing)"
+                } else {
+                    "squeals"
+                };
+                format!(
+                    "{verb} at {} ({what}): {} RMS = {:.1} dB re 1 m/s; verdict {}",
+                    si(s.frequency_hz, "Hz", 4),
+                    si(s.rms, "m/s", 3),
+                    s.level_db,
+                    j.verdict
+                )
+            }
+            None => format!("does not squeal: verdict {} ({})", j.verdict, j.reason),
+        }
     }
 
     /// The `growth_rate` key of summary.json: per velocity, rate (1/s) and window (s).
@@ -464,6 +572,41 @@ pub fn draw(
         .map_err(plot_err)?;
     }
     Ok(())
+}
+
+/// `x` with an SI prefix and `digits` significant digits: `si(20751.3, "Hz", 4)`
+/// = "20.75 kHz", `si(3.2e-6, "m/s", 3)` = "3.20 µm/s".
+pub fn si(x: f64, unit: &str, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x} {unit}");
+    }
+    const P: [(f64, &str); 9] = [
+        (1e9, "G"),
+        (1e6, "M"),
+        (1e3, "k"),
+        (1.0, ""),
+        (1e-3, "m"),
+        (1e-6, "µ"),
+        (1e-9, "n"),
+        (1e-12, "p"),
+        (1e-15, "f"),
+    ];
+    let a = x.abs();
+    let (scale, prefix) = P
+        .iter()
+        .copied()
+        .find(|(s, _)| a >= *s * 0.999_95)
+        .unwrap_or((1e-15, "f"));
+    let v = x / scale;
+    let int_digits = if v.abs() >= 100.0 {
+        3
+    } else if v.abs() >= 10.0 {
+        2
+    } else {
+        1
+    };
+    let dec = digits.saturating_sub(int_digits);
+    format!("{v:.dec$} {prefix}{unit}")
 }
 
 /// Row-major (time, freq) → row-major (freq, time): heatmap rows are y.

@@ -79,8 +79,8 @@ fn thesis_first_run_rings_at_the_normal_frequency_and_has_no_tangential_motion()
     let svg = std::fs::read_to_string(dir.join("triplet.svg")).unwrap();
     assert!(svg.contains("identically zero"), "zero-signal note");
     assert_eq!(
-        s["verdict"], "limit-cycle",
-        "undamped normal ringing persists"
+        s["verdict"], "neutral",
+        "undamped normal ringing persists, neither growing nor decaying"
     );
 }
 

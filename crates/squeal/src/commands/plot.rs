@@ -26,7 +26,10 @@ pub fn run(a: PlotArgs) -> Result<(), RunError> {
         .unwrap_or("run")
         .to_string();
     let channels = channels_for(model);
-    let an = analysis::analyse(&run, &channels, &settings);
+    let validity = summary["scenario"]["validity"]
+        .as_f64()
+        .unwrap_or(crate::scenario::VALIDITY);
+    let an = analysis::analyse(&run, &channels, &settings, validity);
     analysis::draw(&run, &an, &channels, &name, &a.run_dir)?;
     analysis::write_spectrum_csv(&an, &a.run_dir.join("spectrum.csv"))?;
     println!(

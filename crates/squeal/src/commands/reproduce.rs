@@ -181,7 +181,12 @@ fn measure(id: usize, sc: Scenario, figures: Option<&Path>) -> Result<SetResult,
     };
     let run: Run = run::run_with(&sc, &indicatif::ProgressBar::hidden())?;
     let ch = sc.model.channels();
-    let an: Analysis = analysis::analyse(&run, &ch, &analysis::SpectrumSettings::default());
+    let an: Analysis = analysis::analyse(
+        &run,
+        &ch,
+        &analysis::SpectrumSettings::default(),
+        sc.validity,
+    );
     if let Some(dir) = figures {
         let d = dir.join(format!("set{id:02}"));
         std::fs::create_dir_all(&d)

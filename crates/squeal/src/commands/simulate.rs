@@ -118,11 +118,13 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
     summary["columns"] = json!(run.columns);
     summary["rms"] = json!(output::tail_rms(&run, &velocity_names));
     let channels = sc.model.channels();
-    let an = analysis::analyse(&run, &channels, &spectrum_settings);
+    let an = analysis::analyse(&run, &channels, &spectrum_settings, sc.validity);
     analysis::write_spectrum_csv(&an, &stage.path("spectrum.csv"))?;
     summary["spectrum"] = an.spectrum_json();
     summary["growth_rate"] = an.growth_json();
     summary["verdict"] = json!(an.verdict.as_str());
+    summary["verdict_detail"] = an.verdict_detail_json();
+    summary["squeal"] = an.squeal_json();
     if !a.no_plots {
         analysis::draw(&run, &an, &channels, &sc.name, stage.dir())?;
     }
@@ -147,6 +149,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
             serde_json::to_string_pretty(&summary).map_err(|e| RunError::Io(e.to_string()))?
         );
     } else {
+        println!("{}", an.squeal_line(crate::model::coordinate_words));
         print_human(&sc, &run, &summary, &dest);
     }
     Ok(())
@@ -195,6 +198,20 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
     if !dom.is_empty() {
         println!("dominant frequencies: {}", dom.join(", "));
     }
-    println!("verdict: {}", summary["verdict"].as_str().unwrap_or("?"));
+    println!(
+        "verdict: {} — {}",
+        summary["verdict"].as_str().unwrap_or("?"),
+        summary["verdict_detail"]["reason"].as_str().unwrap_or("")
+    );
+    if let Some(c) = summary["verdict_detail"]["per_cycle"].as_object() {
+        let g = |k: &str| c.get(k).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
+        println!(
+            "per cycle of the squeal ({:.0} cycles in the judged window): {:.3} true sticks, {:.3} slip reversals, {:.3} separations",
+            g("cycles"),
+            g("sticks_per_cycle"),
+            g("reversals_per_cycle"),
+            g("separations_per_cycle")
+        );
+    }
     println!("output: {}", dest.display());
 }
