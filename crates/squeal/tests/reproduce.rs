@@ -153,8 +153,30 @@ fn reproduce_writes_the_table_the_conclusions_and_the_report() {
     // Set 40 leaves the model: never "decays", and flagged in the table.
     let table = std::fs::read_to_string(dir.join("table.csv")).unwrap();
     let r40 = row(&table, 40);
-    // (set 40 assertions arrive with the verdict vocabulary of issue 10)
-    let _ = &r40;
+    assert_ne!(r40["verdict"], "decays");
+    assert_eq!(r40["valid"], "false");
+    assert!(
+        md.contains("| ⚠ out-of-range (outside the model) |")
+            || md.contains("| ⚠ lift-off (outside the model) |"),
+        "flagged in the report's table"
+    );
+    // Set 15's squeal is the pad's tangential mode at 20.75 kHz.
+    let r15 = row(&table, 15);
+    assert_eq!(r15["squeal_coordinate"], "x_p");
+    let f: f64 = r15["squeal_frequency_hz"].parse().unwrap();
+    assert!((f - 20_751.0).abs() <= 0.005 * 20_751.0, "{f}");
+    assert!(r15["squeal_level_db"].parse::<f64>().is_ok());
+    assert!(
+        md.contains("Sets that squeal: ") && md.contains("15 (x_p 2075"),
+        "squeal in the report"
+    );
+    // Quiet sets leave the squeal columns empty.
+    let r29 = row(&table, 29);
+    assert_eq!(r29["squeal_coordinate"], "");
+    assert_eq!(r29["squeal_frequency_hz"], "");
+    // The pad beside the thesis's disc panels.
+    assert!(dir.join("figures/set15/pad.png").is_file());
+    assert!(html.contains("figures/set15/pad.png"));
     assert!(cs[6]["evidence"].as_str().unwrap().contains("Set 39"));
 
     // C5 counts sticks and reversals separately, with the stick window.

@@ -118,11 +118,14 @@ impl SetResult {
     fn agrees(&self) -> Option<bool> {
         let word = self.linear_word();
         let v = self.verdict.as_str();
+        if self.outside().is_some() || v == "too-short" {
+            return None;
+        }
         match word {
             "none" => None,
-            "unstable" => Some(v == "grows" || v == "stick-slip"),
+            "unstable" => Some(matches!(v, "grows" | "stick-slip" | "limit-cycle")),
             "stable" => Some(v == "decays"),
-            _ => Some(v == "limit-cycle" || v == "decays"),
+            _ => Some(matches!(v, "neutral" | "limit-cycle" | "decays")),
         }
     }
 }
@@ -169,9 +172,47 @@ fn linear_of(model: &AnyModel) -> Result<Linear, String> {
     })
 }
 
+/// The pad's panels beside the thesis's disc panels: its tangential velocity
+/// against time and that velocity's power spectral density (`pad.png`/`.svg`).
+fn draw_pad(run: &Run, title: &str, dir: &Path) -> Result<(), RunError> {
+    use squeal_plot::{Panel, Series};
+    let (Some(t), Some(x)) = (run.column("t"), run.column("vx_p")) else {
+        return Ok(());
+    };
+    let vtitle = format!("{title}: pad tangential velocity vx_p");
+    let mut panels =
+        vec![Panel::new(&vtitle, "time (s)", "velocity (m/s)").with_series(Series::new("", t, x))];
+    let spec =
+        squeal_signal::welch(x, run.sample_rate, &squeal_signal::WelchOptions::default()).ok();
+    let db = spec.as_ref().map(|s| s.to_db()).unwrap_or_default();
+    let peak = spec.as_ref().and_then(|s| {
+        (1..s.len())
+            .max_by(|a, b| s.psd[*a].total_cmp(&s.psd[*b]))
+            .map(|k| s.freq[k])
+    });
+    let label = peak.map_or(String::new(), |f| format!("{f:.1} Hz"));
+    let ptitle = format!("{title}: power spectral density of vx_p (Hann window)");
+    if let Some(s) = &spec {
+        let mut p = Panel::new(&ptitle, "frequency (Hz)", "PSD (dB re 1 (m/s)²/Hz)")
+            .with_series(Series::new("", &s.freq, &db));
+        if let Some(f) = peak {
+            p = p.with_peak(f, &label);
+        }
+        panels.push(p);
+    }
+    let size = (1200, 300 * panels.len() as u32);
+    squeal_plot::line_panels(dir.join("pad"), &[Format::Png, Format::Svg], size, &panels)
+        .map_err(|e| RunError::Io(format!("drawing failed: {e}")))?;
+    Ok(())
+}
+
 /// The squeal of a run, as the analysis answers it.
-fn squeal_answer(_an: &Analysis) -> Option<SquealAnswer> {
-    None
+fn squeal_answer(an: &Analysis) -> Option<SquealAnswer> {
+    an.judgement.squeal.as_ref().map(|s| SquealAnswer {
+        coordinate: s.coordinate.clone(),
+        frequency_hz: s.frequency_hz,
+        level_db: s.level_db,
+    })
 }
 
 fn measure(id: usize, sc: Scenario, figures: Option<&Path>) -> Result<SetResult, RunError> {
@@ -192,6 +233,7 @@ fn measure(id: usize, sc: Scenario, figures: Option<&Path>) -> Result<SetResult,
         std::fs::create_dir_all(&d)
             .map_err(|e| RunError::Io(format!("cannot create {}: {e}", d.display())))?;
         analysis::draw(&run, &an, &ch, &format!("set {id}"), &d)?;
+        draw_pad(&run, &format!("set {id}"), &d)?;
     }
     let col = |n: &str| run.column(n).unwrap_or(&[]);
     let vxd = col("vx_d");
@@ -364,9 +406,10 @@ fn db(x: f64) -> f64 {
     20.0 * x.max(1e-300).log10()
 }
 
-/// A run squeals when its vibration grows or is sustained by friction.
+/// A run squeals when its vibration grows or is sustained (the verdict
+/// vocabulary's squealing words; lift-off is outside the model, not evidence).
 fn squeals(r: &SetResult) -> bool {
-    matches!(r.verdict.as_str(), "grows" | "stick-slip")
+    matches!(r.verdict.as_str(), "grows" | "stick-slip" | "limit-cycle")
 }
 
 /// Follower-force sweep: negative α values (log-spaced −1 … −1e5) and positive ones.
@@ -465,11 +508,15 @@ fn sweeps(set15: &Scenario) -> Result<Sweeps, RunError> {
     );
     let (cpx, kicked) = (cpx?, kicked?);
     let ch = base.channels();
-    let kicked_verdict =
-        analysis::analyse(&kicked.run, &ch, &analysis::SpectrumSettings::default())
-            .verdict
-            .as_str()
-            .to_string();
+    let kicked_verdict = analysis::analyse(
+        &kicked.run,
+        &ch,
+        &analysis::SpectrumSettings::default(),
+        set15.validity,
+    )
+    .verdict
+    .as_str()
+    .to_string();
     Ok(Sweeps {
         above_uc: worst,
         below_uc: below,
@@ -674,7 +721,7 @@ fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
         r.p("alpha") == 0.0 && r.first_reversal.is_some_and(|t| t >= 0.6 * r.sc.duration)
     });
     let bounded: Vec<&SetResult> = pick(&saturated, |r| {
-        r.verdict == "stick-slip" && r.vxp_max <= 2.0 * r.p("V")
+        matches!(r.verdict.as_str(), "stick-slip" | "limit-cycle") && r.vxp_max <= 2.0 * r.p("V")
     });
     let unsat: Vec<&SetResult> = pick(&unstable, |r| r.first_reversal.is_none());
     let ratio = saturated
@@ -1025,7 +1072,7 @@ fn grade_counts(cs: &[Conclusion]) -> String {
 }
 
 /// The verdict words of the simulated runs and what each means.
-const VERDICT_WORDS: [(&str, &str); 7] = [
+const VERDICT_WORDS: [(&str, &str); 8] = [
     ("decays", "the vibration dies away"),
     ("grows", "the vibration is still growing when the run ends"),
     ("limit-cycle", "a bounded, sustained, smooth oscillation (no friction events keep it bounded)"),
@@ -1033,6 +1080,7 @@ const VERDICT_WORDS: [(&str, &str); 7] = [
     ("neutral", "an undamped linear oscillation that neither grows nor decays"),
     ("lift-off", "the pad loses contact with the disc repeatedly; the run is outside the model's range of validity"),
     ("out-of-range", "the run leaves the model's range of validity (displacements far beyond what a lumped linear-elastic model means)"),
+    ("too-short", "the run is too short to tell growth from decay"),
 ];
 
 /// The window length T over which the mean of `exp(2·rate·t)`, t ∈ [0, T],
@@ -1255,7 +1303,11 @@ fn report_md(
             r.events[EventKind::Separate.index()]
         );
         if figures {
-            let _ = writeln!(m, "![set {0}](figures/set{0:02}/triplet.png)\n", r.id);
+            let _ = writeln!(
+                m,
+                "![set {0}: disc, as the thesis drew it](figures/set{0:02}/triplet.png) ![set {0}: pad](figures/set{0:02}/pad.png)\n",
+                r.id
+            );
         }
     }
     m
@@ -1531,15 +1583,25 @@ fn report_html(md: &str) -> String {
             let _ = writeln!(h, "<h2>{}</h2>", inline(t));
         } else if let Some(t) = line.strip_prefix("# ") {
             let _ = writeln!(h, "<h1>{}</h1>", inline(t));
-        } else if let Some(rest) = line.strip_prefix("![") {
-            if let Some((alt, src)) = rest.split_once("](") {
-                let _ = writeln!(
-                    h,
-                    "<p><img alt=\"{}\" src=\"{}\"></p>",
-                    esc(alt),
-                    esc(src.trim_end_matches(')'))
-                );
+        } else if line.starts_with("![") {
+            // One or more images on a line: side by side.
+            let imgs: Vec<(&str, &str)> = line
+                .split("![")
+                .filter_map(|part| {
+                    let (alt, rest) = part.split_once("](")?;
+                    Some((alt, rest.split_once(')')?.0))
+                })
+                .collect();
+            let width = if imgs.len() > 1 {
+                " style=\"max-width:49%\""
+            } else {
+                ""
+            };
+            h.push_str("<p>");
+            for (alt, src) in imgs {
+                let _ = write!(h, "<img alt=\"{}\" src=\"{}\"{width}>", esc(alt), esc(src));
             }
+            h.push_str("</p>\n");
         } else if !line.trim().is_empty() {
             let _ = writeln!(h, "<p>{}</p>", inline(line));
         }
@@ -1723,5 +1785,22 @@ mod tests {
         );
         assert_eq!(h.matches("<em>").count(), h.matches("</em>").count());
         assert!(h.contains("<table>") && h.contains("<td>1</td>"));
+        let two = report_html("![disc](a/triplet.png) ![pad](a/pad.png)\n");
+        assert_eq!(
+            two,
+            report_html("")
+                .replace("</body>", "<p><img alt=\"disc\" src=\"a/triplet.png\" style=\"max-width:49%\"><img alt=\"pad\" src=\"a/pad.png\" style=\"max-width:49%\"></p>\n</body>")
+        );
+    }
+
+    #[test]
+    fn grades_and_power_window() {
+        assert!(Grade::Qualitatively.held() && Grade::AnotherMechanism.held());
+        assert!(!Grade::Refuted.held() && !Grade::Outside.held());
+        // mean of exp(2·rate·t) over [0, T] = ratio: check by the closed form.
+        let t = window_for_ratio(-4.5, 0.5).unwrap();
+        let x = 9.0 * t;
+        assert!(((1.0 - (-x).exp()) / x - 0.5).abs() < 1e-9, "{t}");
+        assert!(window_for_ratio(1.0, 0.5).is_none());
     }
 }
