@@ -1185,10 +1185,26 @@ fn report_md(
     let _ = writeln!(
         m,
         "The thesis judged stability from runs alone. For every sliding set the eigenvalues of the steady-sliding \
-         state (docs/physics.md §5) give a linear verdict; it agrees with the simulated outcome in {} of {} sets. Where they \
+         state (docs/physics.md §5) give a linear verdict; it agrees with the simulated outcome in {} of {} sets{}. Where they \
          differ: {}.\n",
         rs.iter().filter(|r| r.agrees() == Some(true)).count(),
         rs.iter().filter(|r| r.agrees().is_some()).count(),
+        {
+            let out: Vec<String> = rs
+                .iter()
+                .filter(|r| r.p("V") > 0.0 && r.agrees().is_none())
+                .map(|r| format!("{} ({})", r.id, r.verdict))
+                .collect();
+            if out.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " (not compared: sets {} — contact loss or a run outside the model's validity is beyond what a \
+                     linearisation about steady sliding describes, and a run too short to tell has no outcome)",
+                    out.join(", ")
+                )
+            }
+        },
         if dis.is_empty() {
             "nowhere".to_string()
         } else {
