@@ -476,6 +476,47 @@ mod tests {
         assert!((b[0].1 - 1.0).abs() < 0.01, "{}", b[0].1);
     }
 
+    /// Every 1 % threshold of the α sweep is where the followed mode's growth
+    /// rate has changed by 1 % (recomputed independently at that α), and the
+    /// thresholds match the sizes of the terms: the pad's normal damping
+    /// (σ ≈ −1.15 1/s) first, near |α| ≈ 80 1/m, the tangential growth rates
+    /// at a few hundred.
+    #[test]
+    fn alpha_thresholds_are_where_the_modes_change_by_one_percent() {
+        let base = DiscPad::default();
+        let a = alpha_sweep(&base, 31, 11, -1e5).unwrap();
+        assert_eq!((a.n_neg, a.n_pos), (31, 11));
+        for m in &a.modes {
+            let Some(at) = m.sigma_at[0] else { continue };
+            let mm = with(&base, "alpha", -at).unwrap();
+            let v = modes(&mm).unwrap();
+            let l = v
+                .iter()
+                .map(|x| x.0)
+                .min_by(|x, y| {
+                    (x.im / std::f64::consts::TAU - m.freq0)
+                        .abs()
+                        .total_cmp(&(y.im / std::f64::consts::TAU - m.freq0).abs())
+                })
+                .unwrap();
+            let change = ((l.re - m.sigma0) / m.sigma0).abs();
+            assert!((change - 0.01).abs() < 1e-5, "{}: {change} at {at}", m.name);
+            if let Some(ten) = m.sigma_at[1] {
+                assert!(ten > at, "{}", m.name);
+            }
+        }
+        let get = |n: &str| a.modes.iter().find(|m| m.name == n).unwrap();
+        let yp = get("y_p").sigma_at[0].unwrap();
+        assert!((60.0..100.0).contains(&yp), "{yp}");
+        for n in ["x_d", "x_p"] {
+            let t = get(n).sigma_at[0].unwrap();
+            assert!((200.0..1000.0).contains(&t), "{n}: {t}");
+        }
+        // The limit of steady sliding: 1 − α·μ(V)·y_d* = 0.
+        let mu = base.friction.mu(1.0);
+        assert!((a.limit + 8.0e6 / (mu * 500.0)).abs() < 1e-6 * a.limit.abs());
+    }
+
     #[test]
     fn stick_durations_and_counts() {
         use EventKind::*;

@@ -1705,7 +1705,7 @@ fn draw_map(rs: &[SetResult], dir: &Path) -> Result<String, RunError> {
         value_range: crate::commands::map::robust_range(&vals),
         nan_label: "no steady sliding",
         ..HeatmapSpec::new(
-            "Stability of steady sliding, other parameters at their defaults, with the sets that share them",
+            "Steady sliding at the defaults, with the sets that share them",
             "V (m/s)",
             "N (N)",
             "max growth rate σ (1/s)",
