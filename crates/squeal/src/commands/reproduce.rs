@@ -57,6 +57,8 @@ struct SetResult {
     linear: Option<Linear>,
     linear_note: String,
     verdict: String,
+    /// The squeal answer (`summary.json`'s `squeal`): coordinate, Hz, dB re 1 m/s.
+    squeal: Option<(String, f64, f64)>,
     f_t: Option<f64>,
     f_n: Option<f64>,
     growth: Vec<(String, f64)>,
@@ -94,9 +96,13 @@ impl SetResult {
         let v = self.verdict.as_str();
         match word {
             "none" => None,
-            "unstable" => Some(v == "grows" || v == "stick-slip"),
+            // Growth that saturates (any bounded sustained cycle) agrees with instability.
+            "unstable" => Some(matches!(
+                v,
+                "grows" | "stick-slip" | "limit-cycle" | "lift-off" | "out-of-range"
+            )),
             "stable" => Some(v == "decays"),
-            _ => Some(v == "limit-cycle" || v == "decays"),
+            _ => Some(v == "neutral" || v == "limit-cycle" || v == "decays"),
         }
     }
 }
@@ -199,6 +205,11 @@ fn measure(id: usize, sc: Scenario, figures: Option<&Path>) -> Result<SetResult,
         linear,
         linear_note,
         verdict: an.verdict.as_str().to_string(),
+        squeal: an
+            .judgement
+            .squeal
+            .as_ref()
+            .map(|q| (q.coordinate.clone(), q.frequency_hz, q.level_db)),
         f_t,
         f_n,
         growth: an.growth.iter().map(|g| (g.0.clone(), g.1)).collect(),
@@ -546,7 +557,7 @@ fn opt(x: Option<f64>, prec: usize) -> String {
 /// The parameters the table shows for every set (the ones the sets vary).
 const TABLE_PARAMS: [&str; 8] = ["V", "N", "f1", "alpha", "c_dx", "c_dy", "c_px", "c_py"];
 
-const TABLE_HEADER: &str = "set,question,V,N,f1,alpha,c_dx,c_dy,c_px,c_py,duration,linear,max_growth_rate,least_stable_hz,verdict,tangential_hz,normal_hz,growth_rate_vx_p,growth_rate_vx_d,stick_fraction,reversals,sticks,tangential_zero,agree";
+const TABLE_HEADER: &str = "set,question,V,N,f1,alpha,c_dx,c_dy,c_px,c_py,duration,linear,max_growth_rate,least_stable_hz,verdict,tangential_hz,normal_hz,growth_rate_vx_p,growth_rate_vx_d,stick_fraction,reversals,sticks,tangential_zero,agree,squeal_coordinate,squeal_frequency_hz,squeal_level_db";
 
 fn table_csv(rs: &[SetResult]) -> String {
     let mut t = String::from(TABLE_HEADER);
@@ -579,6 +590,14 @@ fn table_csv(rs: &[SetResult]) -> String {
             r.tangential_zero,
             r.agrees().map_or("", |a| if a { "yes" } else { "no" }),
         );
+        // The squeal answer, empty when nothing squeals (appended to the row above).
+        t.pop();
+        match &r.squeal {
+            Some((c, f, db)) => {
+                let _ = writeln!(t, ",{c},{f:.2},{db:.2}");
+            }
+            None => t.push_str(",,,\n"),
+        }
     }
     t
 }
@@ -679,11 +698,11 @@ fn report_md(rs: &[SetResult], cs: &[Conclusion], scale: f64, figures: bool, wal
     let _ = writeln!(m, "## Table 11.1, reconstructed, with results\n");
     let _ = writeln!(
         m,
-        "| set | question | V | N | f1 | α | c_dx | c_dy | c_px | c_py | linear | σ_max (1/s) | verdict | f_t (Hz) | f_n (Hz) | σ fit pad (1/s) | stick fraction | reversals |"
+        "| set | question | V | N | f1 | α | c_dx | c_dy | c_px | c_py | linear | σ_max (1/s) | verdict | squeal | f_t (Hz) | f_n (Hz) | σ fit pad (1/s) | stick fraction | reversals |"
     );
     let _ = writeln!(
         m,
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for r in rs {
         let params: Vec<String> = TABLE_PARAMS
@@ -698,7 +717,7 @@ fn report_md(rs: &[SetResult], cs: &[Conclusion], scale: f64, figures: bool, wal
             .collect();
         let _ = writeln!(
             m,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2e} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2e} | {} |",
             r.id,
             r.sc.description,
             params.join(" | "),
@@ -707,6 +726,10 @@ fn report_md(rs: &[SetResult], cs: &[Conclusion], scale: f64, figures: bool, wal
                 .as_ref()
                 .map_or("—".into(), |l| format!("{:+.3}", l.max_growth)),
             r.verdict,
+            r.squeal.as_ref().map_or("—".into(), |(c, f, db)| format!(
+                "{c} at {}, {db:.1} dB",
+                crate::analysis::si(*f, "Hz", 4)
+            )),
             opt(r.f_t, 1),
             opt(r.f_n, 1),
             opt(r.growth_of("vx_p"), 3),
