@@ -14,7 +14,7 @@ use crate::study::{self, AboveUc, AlphaSweep, CpxSweep, StickStats};
 use clap::Args;
 use rayon::prelude::*;
 use serde_json::{json, Value};
-use squeal_core::stability::{self, NEUTRAL_TOL};
+use squeal_core::stability;
 use squeal_core::{EventKind, Model};
 use squeal_plot::{Colormap, Format, HeatmapSpec};
 use squeal_signal::Spectrum;
@@ -153,15 +153,11 @@ fn prominence(s: &Spectrum, f: f64) -> Option<f64> {
 fn linear_of(model: &AnyModel) -> Result<Linear, String> {
     let an = eigen_analyse(model).map_err(|e| e.to_string())?;
     let ls = an.least_stable_mode();
-    let neutral = !an.eigen.iter().any(|e| e.growing)
-        && an
-            .eigen
-            .iter()
-            .any(|e| e.re.abs() <= NEUTRAL_TOL * e.re.hypot(e.im));
+    let neutral = an.neutral;
     Ok(Linear {
         max_growth: an.max_growth_rate,
         freq_hz: ls.freq_hz,
-        growing: !an.stable,
+        growing: an.eigen.iter().any(|e| e.growing),
         neutral,
         modes: an
             .eigen
