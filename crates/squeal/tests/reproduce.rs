@@ -249,6 +249,19 @@ fn reproduce_writes_the_table_the_conclusions_and_the_report() {
     );
     assert!(md.contains("429 Hz against the thesis's \"around 450 Hz\""));
     assert!(md.contains("0.4/0.7"));
+    // The thesis's spectral quantity for set 1, (m/s)²: the step load N rings the
+    // coupled normal mode (disc + pad, M = 1.1 kg, k_dy = 8e6 N/m) with velocity
+    // amplitude N·ω/k_dy, so A² = (N·ω/k_dy)².
+    let a2: f64 = md
+        .split("Welch segments — is ")
+        .nth(1)
+        .and_then(|t| t.split(" J/kg").next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    let w = (8.0e6f64 / 1.1).sqrt();
+    let exact = (500.0 * w / 8.0e6).powi(2);
+    assert!((a2 - exact).abs() < 0.02 * exact, "{a2} vs {exact}");
 
     // Byte-identical with one thread, and no wall-clock time anywhere in it.
     reproduce(d.path(), "rep1", "1", &[]);

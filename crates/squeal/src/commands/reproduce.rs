@@ -1499,14 +1499,20 @@ fn levels_section(m: &mut String, rs: &[SetResult]) {
          peak amplitude A² of the disc's normal velocity at its spectral peak, flat-top window, averaged over the run's \
          Welch segments — is {p1:.4} J/kg at {f1:.1} Hz for set 1 and {p2:.4} J/kg for set 2 (mean square A²/2: {:.4} and \
          {:.4} J/kg). The absolute levels differ by a factor {:.0} ({:.1} dB): the thesis's normalisation (an FFT length and \
-         scaling that were lost; an unnormalised |FFT|² grows with the FFT length) cannot be recovered, so only the ratio \
-         is comparable. The thesis's damped/undamped ratio is 0.4/0.7 = {thesis:.3} ({:.1} dB); squeal's is {ratio:.3} \
+         scaling that were lost; an unnormalised |FFT|² grows with the FFT length) cannot be recovered. Read as A², the \
+         thesis's 0.7 J/kg would mean a velocity amplitude of {:.3} m/s; the pad's step load N gives the coupled normal mode \
+         an amplitude N/(ω·M), so that would need a moving mass M = {:.3} kg instead of the reconstruction's \
+         m_d + m_p = {:.1} kg (the disc's modal mass, itself a reconstruction). Only the ratio is free of the \
+         normalisation. The thesis's damped/undamped ratio is 0.4/0.7 = {thesis:.3} ({:.1} dB); squeal's is {ratio:.3} \
          ({:.1} dB) over {} s runs. Set 2's normal vibration decays at {} 1/s, so the ratio depends on how long the \
          analysed window is: a power average from t = 0 over {} reproduces the thesis's ratio.\n",
         p1 / 2.0,
         p2 / 2.0,
         0.7 / p1,
         10.0 * (0.7 / p1).log10(),
+        0.7f64.sqrt(),
+        r1.p("N") / (std::f64::consts::TAU * f1 * 0.7f64.sqrt()),
+        r1.p("m_d") + r1.p("m_p"),
         10.0 * thesis.log10(),
         10.0 * ratio.log10(),
         r2.sc.duration,
