@@ -1587,7 +1587,7 @@ fn report_html(md: &str) -> String {
             let cells: Vec<&str> = line.trim_matches('|').split(" | ").collect();
             h.push_str("<tr>");
             for c in cells {
-                let _ = write!(h, "<td>{}</td>", inline(c.trim()));
+                let _ = write!(h, "<td>{}</td>", inline(&c.trim().replace("\\|", "|")));
             }
             h.push_str("</tr>\n");
             continue;
@@ -1803,6 +1803,8 @@ mod tests {
         );
         assert_eq!(h.matches("<em>").count(), h.matches("</em>").count());
         assert!(h.contains("<table>") && h.contains("<td>1</td>"));
+        let esc = report_html("| σ at \\|α\\| | x |\n|---|---|\n");
+        assert!(esc.contains("<td>σ at |α|</td>"), "{esc}");
         let two = report_html("![disc](a/triplet.png) ![pad](a/pad.png)\n");
         assert_eq!(
             two,
