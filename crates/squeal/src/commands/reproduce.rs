@@ -1,9 +1,16 @@
 //! `squeal reproduce [--out DIR]`: the thesis's study re-done, checked and
 //! extended in one command — the 40 parameter sets of Table 11.1
 //! (reconstructed, `scenarios/thesis/`), Appendix A's pictures for each set
-//! plus its eigenvalues, the seven conclusions of MODEL.md §6 turned into
-//! measurable claims and evaluated on this invocation's runs, and a V × N
-//! stability map with the sets marked.
+//! (the disc as the thesis drew it, the pad beside it) plus its eigenvalues,
+//! the seven conclusions of docs/physics.md §6 turned into measurable claims,
+//! evaluated on this invocation's runs and on the studies of [`crate::study`]
+//! (α sweep, c_px sweep, a kick above Uc), each graded `held`, `held
+//! qualitatively`, `held by another mechanism`, `refuted` or `outside the
+//! model`; runs that leave the model (`lift-off`, `out-of-range`) are flagged
+//! and are evidence for nothing. Also a V × N stability map with the sets that
+//! share its parameters, and the thesis's numbers confronted (450 Hz, the
+//! spectral levels of its Figs. 1–2, its 30–100 kg/s). The report holds no
+//! wall-clock time: the same input gives byte-identical files.
 
 use crate::analysis::{self, Analysis};
 use crate::commands::stability::analyse as eigen_analyse;
