@@ -157,12 +157,20 @@ fn measure(id: usize, sc: Scenario, figures: Option<&Path>) -> Result<SetResult,
         &ch,
         &analysis::SpectrumSettings::default(),
         sc.validity,
+        &[],
     );
     if let Some(dir) = figures {
         let d = dir.join(format!("set{id:02}"));
         std::fs::create_dir_all(&d)
             .map_err(|e| RunError::Io(format!("cannot create {}: {e}", d.display())))?;
-        analysis::draw(&run, &an, &ch, &format!("set {id}"), &d)?;
+        analysis::draw(
+            &run,
+            &an,
+            &ch,
+            &format!("set {id}"),
+            &d,
+            &analysis::PlotSettings::default(),
+        )?;
     }
     let col = |n: &str| run.column(n).unwrap_or(&[]);
     let vxd = col("vx_d");
