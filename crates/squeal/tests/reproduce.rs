@@ -174,9 +174,11 @@ fn reproduce_writes_the_table_the_conclusions_and_the_report() {
     let r29 = row(&table, 29);
     assert_eq!(r29["squeal_coordinate"], "");
     assert_eq!(r29["squeal_frequency_hz"], "");
-    // The pad beside the thesis's disc panels.
-    assert!(dir.join("figures/set15/pad.png").is_file());
-    assert!(html.contains("figures/set15/pad.png"));
+    // The pad's velocity and spectrum beside the thesis's disc panels.
+    let svg = std::fs::read_to_string(dir.join("figures/set15/triplet.svg")).unwrap();
+    for s in ["vx_d", "vy_d", "vx_p"] {
+        assert!(svg.contains(s), "triplet shows {s}");
+    }
     assert!(cs[6]["evidence"].as_str().unwrap().contains("Set 39"));
 
     // C5 counts sticks and reversals separately, with the stick window.

@@ -199,3 +199,178 @@ fn default_squeal_is_the_pad_at_the_least_stable_frequency() {
     let st = pc["sticks_per_cycle"].as_f64().unwrap();
     assert!(rev > 1.0 && st < 0.2, "{pc}");
 }
+
+/// RMS in dB re full scale of a 16-bit WAV, and its raw bytes.
+fn wav_level(path: &Path) -> (f64, Vec<u8>) {
+    let r = hound::WavReader::open(path).unwrap();
+    let y: Vec<f64> = r
+        .into_samples::<i16>()
+        .map(|s| s.unwrap() as f64 / 32767.0)
+        .collect();
+    let ms = y.iter().map(|v| v * v).sum::<f64>() / y.len() as f64;
+    (10.0 * ms.log10(), std::fs::read(path).unwrap())
+}
+
+#[test]
+fn sound_is_honest_louder_vibration_is_louder() {
+    let d = tempfile::tempdir().unwrap();
+    // The squealing default and the same brake damped past both Hopf points.
+    let loud = squeal(d.path(), &["listen", "--out", "loud.wav"]);
+    assert!(loud.status.success());
+    let quiet = squeal(
+        d.path(),
+        &[
+            "listen",
+            "--set",
+            "c_dx=5",
+            "--set",
+            "c_px=5",
+            "--out",
+            "quiet.wav",
+        ],
+    );
+    assert!(quiet.status.success());
+    let text = String::from_utf8_lossy(&loud.stdout);
+    // It plays the squeal (the pad), says the reference, and offers the aid.
+    assert!(text.contains("vx_p (the squeal, 20.75 kHz)"), "{text}");
+    assert!(
+        text.contains("full scale = 2 m/s at gain +0.0 dB"),
+        "{text}"
+    );
+    let err = String::from_utf8_lossy(&loud.stderr);
+    assert!(err.contains("--transpose -2"), "{err}");
+    let (l_db, bytes) = wav_level(&d.path().join("loud.wav"));
+    let (q_db, _) = wav_level(&d.path().join("quiet.wav"));
+    assert!(l_db > q_db + 10.0, "squeal {l_db} dB vs stable {q_db} dB");
+    // At the stated reference: the pad's 0.708 m/s RMS against 2 m/s full
+    // scale is −9.0 dB (±1 dB: fades, loop splices, the resampler's edge).
+    assert!(
+        (l_db - 20.0 * (0.708f64 / 2.0).log10()).abs() < 1.0,
+        "{l_db}"
+    );
+    // The file says so too (RIFF LIST/INFO comment).
+    let s = String::from_utf8_lossy(&bytes);
+    assert!(s.contains("full scale = 2 m/s at gain +0.0 dB"));
+    // --gain moves the level by exactly that much; --transpose is labelled.
+    let out = squeal(
+        d.path(),
+        &[
+            "listen",
+            "--gain",
+            "-6",
+            "--transpose",
+            "-2",
+            "--out",
+            "low.wav",
+        ],
+    );
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("TRANSPOSED -2 octaves"), "{text}");
+    let (t_db, _) = wav_level(&d.path().join("low.wav"));
+    assert!((t_db - (l_db - 6.0)).abs() < 1.0, "{t_db} vs {l_db} − 6");
+    // Bad gains and transpositions are refused.
+    for bad in [["--gain", "nan"], ["--transpose", "10"]] {
+        let out = squeal(d.path(), &["listen", bad[0], bad[1], "--out", "x.wav"]);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        assert!(!d.path().join("x.wav").exists());
+    }
+}
+
+#[test]
+fn spectra_cover_every_velocity_and_signals_chooses() {
+    let d = tempfile::tempdir().unwrap();
+    let out = squeal(
+        d.path(),
+        &[
+            "simulate",
+            "--duration",
+            "0.05",
+            "--out",
+            "r",
+            "--fmax",
+            "25000",
+            "--log-f",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let spec = std::fs::read_to_string(d.path().join("r/spectrum.csv")).unwrap();
+    assert!(spec.starts_with("freq_hz,vx_d_psd,vx_d_db,vx_p_psd,vx_p_db,vy_d_psd"));
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("r/summary.json")).unwrap())
+            .unwrap();
+    let sig = s["spectrum"]["signals"].as_object().unwrap();
+    assert_eq!(sig.len(), 4);
+    // No peak is numerical noise: every labelled peak is within 160 dB of the run's strongest.
+    let top = sig
+        .values()
+        .flat_map(|c| c["peaks"].as_array().unwrap())
+        .map(|p| p["level_db"].as_f64().unwrap())
+        .fold(f64::NEG_INFINITY, f64::max);
+    for c in sig.values() {
+        for p in c["peaks"].as_array().unwrap() {
+            assert!(p["level_db"].as_f64().unwrap() >= top - 160.0, "{p}");
+        }
+    }
+    // --signals chooses; plot keeps summary.json consistent with what it redraws.
+    let out = squeal(
+        d.path(),
+        &["plot", "r", "--signals", "vx_p", "--frange", "15000:25000"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let spec = std::fs::read_to_string(d.path().join("r/spectrum.csv")).unwrap();
+    assert_eq!(spec.lines().next().unwrap(), "freq_hz,vx_p_psd,vx_p_db");
+    let s: Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("r/summary.json")).unwrap())
+            .unwrap();
+    let sig = s["spectrum"]["signals"].as_object().unwrap();
+    assert_eq!(sig.keys().collect::<Vec<_>>(), ["vx_p"]);
+    assert!(s["verdict_detail"].is_object());
+    for bad in [
+        vec!["plot", "r", "--signals", "vz"],
+        vec!["plot", "r", "--fmax", "-1"],
+        vec!["plot", "r", "--frange", "5:1"],
+        vec!["plot", "r", "--fmax", "10", "--frange", "1:5"],
+    ] {
+        let out = squeal(d.path(), &bad);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+    }
+}
+
+#[test]
+fn tiny_signals_get_readable_axes() {
+    // si() and si_scale() give prefixes, never a column of zeros.
+    let d = tempfile::tempdir().unwrap();
+    let out = squeal(
+        d.path(),
+        &[
+            "simulate",
+            "--duration",
+            "0.02",
+            "--set",
+            "N=1e-3",
+            "--out",
+            "r",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let svg = std::fs::read_to_string(d.path().join("r/triplet.svg")).unwrap();
+    assert!(
+        svg.contains("m/s)")
+            && (svg.contains("(µm/s)") || svg.contains("(nm/s)") || svg.contains("(pm/s)")),
+        "SI-prefixed velocity axes"
+    );
+    assert!(svg.contains("frequency (kHz)"));
+}

@@ -19,7 +19,9 @@ pub struct PlotArgs {
 /// Run the command.
 pub fn run(a: PlotArgs) -> Result<(), RunError> {
     let settings = a.spectrum.settings()?;
-    let (run, summary) = output::read_run_dir(&a.run_dir)?;
+    let plot = a.spectrum.plot_settings()?;
+    let (run, mut summary) = output::read_run_dir(&a.run_dir)?;
+    analysis::check_signals(a.spectrum.signals(), &analysis::velocity_columns(&run))?;
     let model = summary["scenario"]["model"].as_str().unwrap_or("disc-pad");
     let name = summary["scenario"]["name"]
         .as_str()
@@ -29,9 +31,20 @@ pub fn run(a: PlotArgs) -> Result<(), RunError> {
     let validity = summary["scenario"]["validity"]
         .as_f64()
         .unwrap_or(crate::scenario::VALIDITY);
-    let an = analysis::analyse(&run, &channels, &settings, validity);
-    analysis::draw(&run, &an, &channels, &name, &a.run_dir)?;
+    let an = analysis::analyse(&run, &channels, &settings, validity, a.spectrum.signals());
+    analysis::draw(&run, &an, &channels, &name, &a.run_dir, &plot)?;
     analysis::write_spectrum_csv(&an, &a.run_dir.join("spectrum.csv"))?;
+    // summary.json says what the redrawn pictures and spectrum.csv show.
+    summary["spectrum"] = an.spectrum_json();
+    summary["growth_rate"] = an.growth_json();
+    summary["verdict"] = serde_json::json!(an.verdict.as_str());
+    summary["verdict_detail"] = an.verdict_detail_json();
+    summary["squeal"] = an.squeal_json();
+    let path = a.run_dir.join("summary.json");
+    let tmp = a.run_dir.join(".summary.json.partial");
+    output::write_json(&summary, &tmp)?;
+    std::fs::rename(&tmp, &path)
+        .map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))?;
     println!(
         "pictures redrawn in {} (triplet, spectrogram, phase; PNG and SVG)",
         a.run_dir.display()

@@ -175,40 +175,6 @@ fn linear_of(model: &AnyModel) -> Result<Linear, String> {
     })
 }
 
-/// The pad's panels beside the thesis's disc panels: its tangential velocity
-/// against time and that velocity's power spectral density (`pad.png`/`.svg`).
-fn draw_pad(run: &Run, title: &str, dir: &Path) -> Result<(), RunError> {
-    use squeal_plot::{Panel, Series};
-    let (Some(t), Some(x)) = (run.column("t"), run.column("vx_p")) else {
-        return Ok(());
-    };
-    let vtitle = format!("{title}: pad tangential velocity vx_p");
-    let mut panels =
-        vec![Panel::new(&vtitle, "time (s)", "velocity (m/s)").with_series(Series::new("", t, x))];
-    let spec =
-        squeal_signal::welch(x, run.sample_rate, &squeal_signal::WelchOptions::default()).ok();
-    let db = spec.as_ref().map(|s| s.to_db()).unwrap_or_default();
-    let peak = spec.as_ref().and_then(|s| {
-        (1..s.len())
-            .max_by(|a, b| s.psd[*a].total_cmp(&s.psd[*b]))
-            .map(|k| s.freq[k])
-    });
-    let label = peak.map_or(String::new(), |f| format!("{f:.1} Hz"));
-    let ptitle = format!("{title}: power spectral density of vx_p (Hann window)");
-    if let Some(s) = &spec {
-        let mut p = Panel::new(&ptitle, "frequency (Hz)", "PSD (dB re 1 (m/s)²/Hz)")
-            .with_series(Series::new("", &s.freq, &db));
-        if let Some(f) = peak {
-            p = p.with_peak(f, &label);
-        }
-        panels.push(p);
-    }
-    let size = (1200, 300 * panels.len() as u32);
-    squeal_plot::line_panels(dir.join("pad"), &[Format::Png, Format::Svg], size, &panels)
-        .map_err(|e| RunError::Io(format!("drawing failed: {e}")))?;
-    Ok(())
-}
-
 /// The squeal of a run, as the analysis answers it.
 fn squeal_answer(an: &Analysis) -> Option<SquealAnswer> {
     an.judgement.squeal.as_ref().map(|s| SquealAnswer {
@@ -230,13 +196,20 @@ fn measure(id: usize, sc: Scenario, figures: Option<&Path>) -> Result<SetResult,
         &ch,
         &analysis::SpectrumSettings::default(),
         sc.validity,
+        &[],
     );
     if let Some(dir) = figures {
         let d = dir.join(format!("set{id:02}"));
         std::fs::create_dir_all(&d)
             .map_err(|e| RunError::Io(format!("cannot create {}: {e}", d.display())))?;
-        analysis::draw(&run, &an, &ch, &format!("set {id}"), &d)?;
-        draw_pad(&run, &format!("set {id}"), &d)?;
+        analysis::draw(
+            &run,
+            &an,
+            &ch,
+            &format!("set {id}"),
+            &d,
+            &analysis::PlotSettings::default(),
+        )?;
     }
     let col = |n: &str| run.column(n).unwrap_or(&[]);
     let vxd = col("vx_d");
@@ -516,6 +489,7 @@ fn sweeps(set15: &Scenario) -> Result<Sweeps, RunError> {
         &ch,
         &analysis::SpectrumSettings::default(),
         set15.validity,
+        &[],
     )
     .verdict
     .as_str()
@@ -1324,7 +1298,7 @@ fn report_md(
         if figures {
             let _ = writeln!(
                 m,
-                "![set {0}: disc, as the thesis drew it](figures/set{0:02}/triplet.png) ![set {0}: pad](figures/set{0:02}/pad.png)\n",
+                "![set {0}: disc and pad velocities and their spectra](figures/set{0:02}/triplet.png)\n",
                 r.id
             );
         }
