@@ -54,21 +54,6 @@ pub(crate) fn diverging(t: f64) -> [u8; 3] {
     interpolate(&RDBU_R, t)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn endpoints_and_centre() {
-        assert_eq!(sequential(0.0), VIRIDIS[0]);
-        assert_eq!(sequential(1.0), VIRIDIS[10]);
-        assert_eq!(sequential(7.0), VIRIDIS[10]);
-        assert_eq!(diverging(0.5), [0xF7, 0xF7, 0xF7]);
-        assert_eq!(diverging(-1.0), RDBU_R[0]);
-        let _ = sequential(f64::NAN);
-    }
-}
-
 /// Qualitative palette for categories (ColorBrewer "Set1" without yellow, then "Dark2"):
 /// colour of class `i` (cycled after 12).
 pub fn qualitative(i: usize) -> [u8; 3] {
@@ -87,4 +72,19 @@ pub fn qualitative(i: usize) -> [u8; 3] {
         [0x00, 0x00, 0x00], // black
     ];
     SET[i % SET.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn endpoints_and_centre() {
+        assert_eq!(sequential(0.0), VIRIDIS[0]);
+        assert_eq!(sequential(1.0), VIRIDIS[10]);
+        assert_eq!(sequential(7.0), VIRIDIS[10]);
+        assert_eq!(diverging(0.5), [0xF7, 0xF7, 0xF7]);
+        assert_eq!(diverging(-1.0), RDBU_R[0]);
+        let _ = sequential(f64::NAN);
+    }
 }
