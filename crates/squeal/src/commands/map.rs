@@ -185,7 +185,10 @@ struct Watch {
 
 impl<const N: usize> Sink<N> for Watch {
     fn sample(&mut self, t: f64, z: &[f64; N], _mode: Mode) -> Flow {
-        if z[..N / 2].iter().any(|q| !(q.abs() <= self.validity)) {
+        if z[..N / 2]
+            .iter()
+            .any(|q| q.is_nan() || q.abs() > self.validity)
+        {
             self.decided = Some("out-of-range");
             return Flow::Stop;
         }
