@@ -37,7 +37,7 @@ pub struct MapArgs {
     /// Output folder (default: out/SCENARIO-map).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Classify every point by simulation too (decays / grows / stick-slip / steady).
+    /// Classify every point by simulation too (decays / grows / stick-slip / steady / out-of-range).
     #[arg(long)]
     transient: bool,
     /// Simulated time per point for --transient (default: the scenario's).
