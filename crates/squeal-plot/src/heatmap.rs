@@ -68,7 +68,7 @@ pub struct HeatmapSpec<'a> {
     pub nan_label: &'a str,
     /// Categories instead of a colour scale: when not empty, `values` are class
     /// indices (0, 1, …; NaN grey), drawn in a qualitative palette
-    /// ([`colormap::qualitative`]) with a legend of these names in place of the colorbar.
+    /// (ColorBrewer Set1, then Dark2) with a legend of these names in place of the colorbar.
     pub classes: &'a [&'a str],
 }
 
