@@ -758,8 +758,10 @@ pub fn draw(
                         values.push(sg.psd_db[i * nf + k]);
                     }
                 }
+                // A 100 dB scale ending at the next 10 dB above the maximum.
+                let top = (sg.max_db() / 10.0).ceil() * 10.0;
                 let spec = HeatmapSpec {
-                    value_range: Some((sg.max_db() - 100.0, sg.max_db())),
+                    value_range: Some((top - 100.0, top)),
                     log_y: plot.log_f,
                     ..HeatmapSpec::new(
                         &title,

@@ -148,7 +148,22 @@ fn transient_map_classifies_by_simulation() {
         } else if sigma > 0.05 {
             assert!(outcome == "stick-slip" || outcome == "grows", "{line}");
         }
+        // The agree column is never empty.
+        assert!(["yes", "no", "n/a"].contains(&f[8]), "{line}");
     }
+    // Drawn as outcome classes with a legend, not a colour scale.
+    let svg = std::fs::read_to_string(d.path().join("t/transient.svg")).unwrap();
+    for class in [
+        "decays",
+        "grows",
+        "stick-slip",
+        "steady",
+        "out-of-range",
+        "failed",
+    ] {
+        assert!(svg.contains(class), "legend lacks {class}");
+    }
+    assert!(!svg.contains("log10 RMS"));
 }
 
 #[test]

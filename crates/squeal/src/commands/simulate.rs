@@ -232,17 +232,18 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
             parts.join(", ")
         );
     }
-    let fmt = |k: &str| {
-        summary["spectrum"][k]["dominant_hz"]
-            .as_f64()
-            .map(|f| format!("{k} {f:.1} Hz"))
-    };
-    let dom: Vec<String> = ["tangential", "normal"]
-        .iter()
-        .filter_map(|k| fmt(k))
-        .collect();
-    if !dom.is_empty() {
-        println!("dominant frequencies: {}", dom.join(", "));
+    if let Some(sig) = summary["spectrum"]["signals"].as_object() {
+        let dom: Vec<String> = sig
+            .iter()
+            .filter_map(|(k, v)| {
+                v["dominant_hz"]
+                    .as_f64()
+                    .map(|f| format!("{k} {}", crate::analysis::si(f, "Hz", 4)))
+            })
+            .collect();
+        if !dom.is_empty() {
+            println!("dominant frequencies: {}", dom.join(", "));
+        }
     }
     println!(
         "verdict: {} — {}",
