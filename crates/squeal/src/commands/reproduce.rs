@@ -1555,7 +1555,7 @@ fn report_html(md: &str) -> String {
     let mut h = String::from(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>squeal: the thesis re-done</title>\n<style>body{font-family:sans-serif;max-width:75em;margin:2em auto;padding:0 1em;line-height:1.45}table{border-collapse:collapse;font-size:85%}td,th{border:1px solid #ccc;padding:2px 6px}img{max-width:100%}code{background:#f4f4f4}</style></head><body>\n",
     );
-    let mut in_table = false;
+    let (mut in_table, mut in_list) = (false, false);
     for line in md.lines() {
         if line.starts_with('|') {
             if line.starts_with("|---") {
@@ -1575,6 +1575,17 @@ fn report_html(md: &str) -> String {
         } else if in_table {
             h.push_str("</table>\n");
             in_table = false;
+        }
+        if let Some(item) = line.strip_prefix("- ") {
+            if !in_list {
+                h.push_str("<ul>\n");
+                in_list = true;
+            }
+            let _ = writeln!(h, "<li>{}</li>", inline(item));
+            continue;
+        } else if in_list {
+            h.push_str("</ul>\n");
+            in_list = false;
         }
         if let Some(t) = line.strip_prefix("### ") {
             let _ = writeln!(h, "<h3>{}</h3>", inline(t));
@@ -1607,6 +1618,9 @@ fn report_html(md: &str) -> String {
     }
     if in_table {
         h.push_str("</table>\n");
+    }
+    if in_list {
+        h.push_str("</ul>\n");
     }
     h.push_str("</body></html>\n");
     h
@@ -1784,6 +1798,11 @@ mod tests {
         );
         assert_eq!(h.matches("<em>").count(), h.matches("</em>").count());
         assert!(h.contains("<table>") && h.contains("<td>1</td>"));
+        let list = report_html("- **held**: as stated.\n- **refuted**: no.\n\nafter\n");
+        assert!(
+            list.contains("<ul>\n<li><strong>held</strong>: as stated.</li>\n<li><strong>refuted</strong>: no.</li>\n</ul>\n<p>after</p>"),
+            "{list}"
+        );
         let esc = report_html("| σ at \\|α\\| | x |\n|---|---|\n");
         assert!(esc.contains("<td>σ at |α|</td>"), "{esc}");
         let two = report_html("![disc](a/triplet.png) ![pad](a/pad.png)\n");
