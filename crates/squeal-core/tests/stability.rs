@@ -485,11 +485,16 @@ fn hoffmann_undamped_flutter_at_coalescence() {
         "{} vs {f}",
         cross.freq_hz
     );
-    // Below: neutral (stable), both frequencies distinct; above: a ±σ pair.
+    // Below: neutral (not stable: no mode is damped), both frequencies
+    // distinct; above: a ±σ pair.
     let mut below = h;
     below.set("mu", 0.9 * mu_c).unwrap();
     let a = analyse(&below).unwrap();
-    assert!(a.stable && a.eigen.iter().all(|e| e.re.abs() <= 1e-12 * e.im.abs()));
+    assert!(!a.stable && a.neutral);
+    assert!(a
+        .eigen
+        .iter()
+        .all(|e| e.neutral && !e.growing && e.re.abs() <= 1e-12 * e.im.abs()));
     let mut above = h;
     above.set("mu", 1.2 * mu_c).unwrap();
     let a = analyse(&above).unwrap();

@@ -54,6 +54,26 @@ pub(crate) fn diverging(t: f64) -> [u8; 3] {
     interpolate(&RDBU_R, t)
 }
 
+/// Qualitative palette for categories (ColorBrewer "Set1" without yellow, then "Dark2"):
+/// colour of class `i` (cycled after 12).
+pub fn qualitative(i: usize) -> [u8; 3] {
+    const SET: [[u8; 3]; 12] = [
+        [0x37, 0x7E, 0xB8], // blue
+        [0xE4, 0x1A, 0x1C], // red
+        [0x4D, 0xAF, 0x4A], // green
+        [0x98, 0x4E, 0xA3], // purple
+        [0xFF, 0x7F, 0x00], // orange
+        [0xA6, 0x56, 0x28], // brown
+        [0xF7, 0x81, 0xBF], // pink
+        [0x1B, 0x9E, 0x77], // teal
+        [0x66, 0x66, 0x66], // dark grey
+        [0xE6, 0xAB, 0x02], // mustard
+        [0x75, 0x70, 0xB3], // slate
+        [0x00, 0x00, 0x00], // black
+    ];
+    SET[i % SET.len()]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -66,6 +66,10 @@ pub struct HeatmapSpec<'a> {
     /// Legend text for grey NaN cells, e.g. `"no steady sliding"`; empty: `"no data"`.
     /// Shown only when NaN cells are present.
     pub nan_label: &'a str,
+    /// Categories instead of a colour scale: when not empty, `values` are class
+    /// indices (0, 1, …; NaN grey), drawn in a qualitative palette
+    /// (ColorBrewer Set1, then Dark2) with a legend of these names in place of the colorbar.
+    pub classes: &'a [&'a str],
 }
 
 impl<'a> HeatmapSpec<'a> {
@@ -94,6 +98,7 @@ impl<'a> HeatmapSpec<'a> {
             contour_zero: false,
             markers: &[],
             nan_label: "",
+            classes: &[],
         }
     }
 }
@@ -124,6 +129,8 @@ struct HeatFigure<'a> {
     /// Colour per kept cell, row-major ny × nx.
     colors: Vec<[u8; 3]>,
     range: (f64, f64),
+    /// Finite values below / above `range`: the colour scale saturates there.
+    clipped: (bool, bool),
     has_nan: bool,
     segments: Vec<Segment>,
     note: Option<String>,
@@ -141,7 +148,9 @@ fn check_axis(name: &str, v: &[f64]) -> Result<(), PlotError> {
     Ok(())
 }
 
-/// Cell edges from centres, in the axis' own (linear or log10) space.
+/// Cell edges from centres, in the axis' own (linear or log10) space. The
+/// outer cells end at the first and last centres (half cells), so the picture
+/// stays inside the data's range (a parameter's LO:HI, a spectrogram's times).
 fn edges(centres_t: &[f64]) -> Vec<f64> {
     let n = centres_t.len();
     if n == 1 {
@@ -150,11 +159,11 @@ fn edges(centres_t: &[f64]) -> Vec<f64> {
         return vec![c - d, c + d];
     }
     let mut e = Vec::with_capacity(n + 1);
-    e.push(centres_t[0] - 0.5 * (centres_t[1] - centres_t[0]));
+    e.push(centres_t[0]);
     for w in centres_t.windows(2) {
         e.push(0.5 * (w[0] + w[1]));
     }
-    e.push(centres_t[n - 1] + 0.5 * (centres_t[n - 1] - centres_t[n - 2]));
+    e.push(centres_t[n - 1]);
     e
 }
 
@@ -222,16 +231,27 @@ impl<'a> HeatFigure<'a> {
             Colormap::Diverging => colormap::diverging,
         };
         let g = [NAN_GREY.0, NAN_GREY.1, NAN_GREY.2];
+        let categorical = !spec.classes.is_empty();
         let colors = vals
             .iter()
             .map(|&v| {
                 if v.is_nan() {
                     g
+                } else if categorical {
+                    colormap::qualitative(v.max(0.0).round() as usize)
                 } else {
                     map((v - range.0) / (range.1 - range.0))
                 }
             })
             .collect();
+        let clipped = if categorical {
+            (false, false)
+        } else {
+            (
+                vals.iter().any(|&v| v < range.0),
+                vals.iter().any(|&v| v > range.1),
+            )
+        };
         let has_nan = vals.iter().any(|v| v.is_nan());
         let segments = if spec.contour_zero {
             // Contour in the axes' display space so that it is straight where the
@@ -252,6 +272,7 @@ impl<'a> HeatFigure<'a> {
             edges_y,
             colors,
             range,
+            clipped,
             has_nan,
             segments,
             note,
@@ -438,7 +459,11 @@ impl HeatFigure<'_> {
             draw_note(root, centre, note, th.note)?;
         }
 
-        self.draw_colorbar(root, px.end + th.px(34.0), py.start, py.end)?;
+        if spec.classes.is_empty() {
+            self.draw_colorbar(root, px.end + th.px(34.0), py.start, py.end)?;
+        } else {
+            self.draw_class_legend(root, px.end + th.px(20.0), py.start)?;
+        }
         if self.has_nan {
             self.draw_nan_legend(root)?;
         }
@@ -473,17 +498,46 @@ impl HeatFigure<'_> {
             [(x, top), (x + bar_w, bottom)],
             INK.stroke_width(1),
         ))?;
+        // Saturation: an extension triangle in the end colour, and the end's
+        // value marked "≥" / "≤", where the data go beyond the scale.
+        let tri = th.px(14.0);
+        for (on, tip, base, t) in [
+            (self.clipped.1, top - tri, top, 1.0),
+            (self.clipped.0, bottom + tri, bottom, 0.0),
+        ] {
+            if on {
+                let [r, g, b] = map(t);
+                let pts = vec![(x, base), (x + bar_w, base), (x + bar_w / 2, tip)];
+                root.draw(&Polygon::new(pts.clone(), RGBColor(r, g, b).filled()))?;
+                let mut outline = pts;
+                outline.push((x, base));
+                root.draw(&PathElement::new(outline, INK.stroke_width(1)))?;
+            }
+        }
         let to_px = |v: f64| bottom - ((v - lo) / (hi - lo) * h as f64).round() as i32;
         let tick_len = th.px(6.0);
         let style = font(th.tick).pos(Pos::new(HPos::Left, VPos::Center));
         let mut max_w = 0;
-        for v in nice_ticks(lo, hi, 6) {
+        let mut ticks: Vec<(f64, String)> = nice_ticks(lo, hi, 6)
+            .into_iter()
+            .map(|v| (v, fmt_tick(v)))
+            .collect();
+        // The saturated ends are labelled with their value, marked ≥ / ≤.
+        let near = |v: f64, end: f64| (v - end).abs() < 0.06 * (hi - lo);
+        if self.clipped.1 {
+            ticks.retain(|(v, _)| !near(*v, hi));
+            ticks.push((hi, format!("≥ {}", fmt_tick(hi))));
+        }
+        if self.clipped.0 {
+            ticks.retain(|(v, _)| !near(*v, lo));
+            ticks.push((lo, format!("≤ {}", fmt_tick(lo))));
+        }
+        for (v, text) in ticks {
             let q = to_px(v);
             root.draw(&PathElement::new(
                 vec![(x + bar_w, q), (x + bar_w + tick_len, q)],
                 INK.stroke_width(1),
             ))?;
-            let text = fmt_tick(v);
             max_w = max_w.max(root.estimate_text_size(&text, &style)?.0 as i32);
             root.draw(&Text::new(
                 text,
@@ -507,6 +561,37 @@ impl HeatFigure<'_> {
                 self.spec.colorbar_label.to_string(),
                 (lx, (top + bottom) / 2),
                 style,
+            ))?;
+        }
+        Ok(())
+    }
+
+    /// One swatch and name per class, top down, in place of the colorbar.
+    fn draw_class_legend<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        x: i32,
+        top: i32,
+    ) -> Result<(), PlotError> {
+        let th = self.theme;
+        let s = th.px(16.0);
+        let step = th.px(26.0);
+        let style = font(th.tick).pos(Pos::new(HPos::Left, VPos::Center));
+        for (i, name) in self.spec.classes.iter().enumerate() {
+            let y = top + th.px(10.0) + i as i32 * step;
+            let [r, g, b] = colormap::qualitative(i);
+            root.draw(&Rectangle::new(
+                [(x, y - s / 2), (x + s, y + s / 2)],
+                RGBColor(r, g, b).filled(),
+            ))?;
+            root.draw(&Rectangle::new(
+                [(x, y - s / 2), (x + s, y + s / 2)],
+                INK.stroke_width(1),
+            ))?;
+            root.draw(&Text::new(
+                name.to_string(),
+                (x + s + th.px(6.0), y),
+                style.clone(),
             ))?;
         }
         Ok(())
@@ -563,7 +648,7 @@ mod tests {
 
     #[test]
     fn edges_from_centres() {
-        assert_eq!(edges(&[1.0, 2.0, 4.0]), vec![0.5, 1.5, 3.0, 5.0]);
+        assert_eq!(edges(&[1.0, 2.0, 4.0]), vec![1.0, 1.5, 3.0, 4.0]);
         assert_eq!(edges(&[2.0]), vec![1.0, 3.0]);
     }
 }

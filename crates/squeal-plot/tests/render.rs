@@ -461,3 +461,42 @@ fn phase_portrait_renders() {
     let e = phase_portrait(&stem, &BOTH, SIZE_SINGLE, &x, &v[..10], &labels);
     assert!(matches!(e, Err(PlotError::Input(_))));
 }
+
+/// A colour scale that clips says so: "≥"/"≤" at the saturated ends (and an
+/// extension triangle); one that does not clip has no such marks.
+#[test]
+fn saturated_colour_scales_are_marked() {
+    let xs = [0.0, 1.0, 2.0];
+    let ys = [0.0, 1.0];
+    let vals = [-50.0, 0.0, 10.0, 20.0, 30.0, 500.0];
+    let dir = tempfile::tempdir().unwrap();
+    let clipped = squeal_plot::HeatmapSpec {
+        value_range: Some((0.0, 100.0)),
+        ..squeal_plot::HeatmapSpec::new("t", "x", "y", "v", &xs, &ys, &vals)
+    };
+    squeal_plot::heatmap(
+        dir.path().join("c"),
+        &[squeal_plot::Format::Svg],
+        (800, 500),
+        &clipped,
+    )
+    .unwrap();
+    let svg = std::fs::read_to_string(dir.path().join("c.svg")).unwrap();
+    assert!(
+        svg.contains("≥ 100") && svg.contains("≤ 0"),
+        "saturation marks"
+    );
+    let free = squeal_plot::HeatmapSpec {
+        value_range: Some((-100.0, 600.0)),
+        ..clipped
+    };
+    squeal_plot::heatmap(
+        dir.path().join("f"),
+        &[squeal_plot::Format::Svg],
+        (800, 500),
+        &free,
+    )
+    .unwrap();
+    let svg = std::fs::read_to_string(dir.path().join("f.svg")).unwrap();
+    assert!(!svg.contains('≥') && !svg.contains('≤'));
+}

@@ -212,6 +212,16 @@ pub struct AudioOptions {
     pub loop_fraction: f64,
     /// Anti-aliasing low-pass of the resampler.
     pub resampler: ResampleOptions,
+    /// A fixed level reference instead of normalisation: the signal value (in its
+    /// own units, e.g. m/s) rendered at full scale (sample value 1) before
+    /// `gain_db`. `None` (default): normalise to `peak`.
+    pub full_scale: Option<f64>,
+    /// Gain in dB applied on top of the `full_scale` reference (default 0).
+    pub gain_db: f64,
+    /// Transposition in octaves (default 0: true pitch). `−2` plays the signal
+    /// two octaves lower: it is resampled as if recorded at `fs_in·2^t`, and the
+    /// clip keeps the duration it would have at true pitch (its last part).
+    pub transpose_octaves: f64,
 }
 
 impl Default for AudioOptions {
@@ -224,6 +234,9 @@ impl Default for AudioOptions {
             crossfade_seconds: 0.005,
             loop_fraction: 0.5,
             resampler: ResampleOptions::default(),
+            full_scale: None,
+            gain_db: 0.0,
+            transpose_octaves: 0.0,
         }
     }
 }
@@ -239,8 +252,14 @@ pub struct AudioClip {
     pub looped: bool,
     /// Duration of the input signal in seconds (`N / fs_in`).
     pub source_seconds: f64,
-    /// Gain applied for normalisation (`peak / max|y|`; 0 for a silent input).
+    /// Gain applied (`peak / max|y|` when normalising, 0 for a silent input;
+    /// `10^(gain_db/20) / full_scale` with a fixed reference).
     pub gain: f64,
+    /// Samples beyond full scale, clipped to ±1 (only with a fixed reference).
+    pub clipped: usize,
+    /// RMS of the clip in dB re full scale (a constant at full scale is 0 dB;
+    /// a full-scale sine −3.01 dB); −inf for silence.
+    pub rms_dbfs: f64,
 }
 
 impl AudioClip {
@@ -258,7 +277,12 @@ impl AudioClip {
 /// and splice point) with a `crossfade_seconds` linear crossfade from the signal's own
 /// continuation into the loop start, and set `looped`; apply raised-cosine fades
 /// (`w = sin²(π/2·(i+½)/L)`) of `fade_seconds` at both ends; normalise so that
-/// `max|y| = peak`·full scale; convert to `f32`. An identically constant input gives silence (all zeros, gain 0).
+/// `max|y| = peak`·full scale — or, with a fixed reference `full_scale`, multiply by
+/// `10^(gain_db/20)/full_scale` (no normalisation: louder input is louder output; samples
+/// beyond full scale are clipped and counted); convert to `f32`. An identically constant
+/// input gives silence (all zeros, gain 0 when normalising). With `transpose_octaves = t`
+/// the input is resampled as if recorded at `fs_in·2^t` (every frequency × 2^t) and the
+/// last part of the result of the true-pitch duration is kept.
 ///
 /// Errors: empty/non-finite signal, `fs_in ≤ 0`, invalid options (including more than 2²⁸
 /// output samples).
@@ -271,7 +295,19 @@ pub fn render_audio(x: &[f64], fs_in: f64, opts: &AudioOptions) -> Result<AudioC
     check_output_len(x.len(), fs_in, rate)?;
     let mean = x.iter().sum::<f64>() / x.len() as f64;
     let centred: Vec<f64> = x.iter().map(|v| v - mean).collect();
-    let y = resample_with(&centred, fs_in, rate, &kernel);
+    // Transposed: the same samples read at fs_in·2^t (a proper band-limited
+    // resampling to the audio rate, not a faster or slower playback of it);
+    // the clip keeps the true-pitch duration, taking the last part.
+    let fs_eff = fs_in * 2f64.powf(opts.transpose_octaves);
+    let y = if opts.transpose_octaves != 0.0 {
+        let kernel_t = Kernel::design(fs_eff, rate, &opts.resampler)?;
+        check_output_len(x.len(), fs_eff, rate)?;
+        let y = resample_with(&centred, fs_eff, rate, &kernel_t);
+        let keep = ((x.len() as f64 / fs_in * rate).round() as usize).clamp(1, y.len());
+        y[y.len() - keep..].to_vec()
+    } else {
+        resample_with(&centred, fs_in, rate, &kernel)
+    };
 
     let min_len = (opts.min_seconds * rate).ceil() as usize;
     let looped = y.len() < min_len;
@@ -293,19 +329,22 @@ pub fn render_audio(x: &[f64], fs_in: f64, opts: &AudioOptions) -> Result<AudioC
         out[len - 1 - i] *= w;
     }
     let peak = out.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let gain = if peak >= f64::MIN_POSITIVE {
-        out.iter_mut().for_each(|v| *v = *v / peak * opts.peak);
-        opts.peak / peak
-    } else {
-        out.iter_mut().for_each(|v| *v = 0.0);
-        0.0
+    let gain = match opts.full_scale {
+        Some(fsv) => 10f64.powf(opts.gain_db / 20.0) / fsv,
+        None if peak >= f64::MIN_POSITIVE => opts.peak / peak,
+        None => 0.0,
     };
+    out.iter_mut().for_each(|v| *v *= gain);
+    let clipped = out.iter().filter(|v| v.abs() > 1.0).count();
+    let ms = out.iter().map(|v| v.clamp(-1.0, 1.0).powi(2)).sum::<f64>() / out.len().max(1) as f64;
     Ok(AudioClip {
         samples: out.iter().map(|&v| (v as f32).clamp(-1.0, 1.0)).collect(),
         sample_rate: opts.sample_rate,
         looped,
         source_seconds: x.len() as f64 / fs_in,
         gain,
+        clipped,
+        rms_dbfs: 10.0 * ms.log10(),
     })
 }
 
@@ -380,6 +419,26 @@ fn validate(o: &AudioOptions) -> Result<()> {
     }
     if !(o.loop_fraction > 0.0 && o.loop_fraction <= 1.0) {
         return Err(invalid("loop_fraction", "must be in (0, 1]"));
+    }
+    if let Some(f) = o.full_scale {
+        if !(f.is_finite() && f > 0.0) {
+            return Err(invalid(
+                "full_scale",
+                format!("must be finite and > 0, got {f}"),
+            ));
+        }
+    }
+    if !(o.gain_db.is_finite() && o.gain_db.abs() <= 200.0) {
+        return Err(invalid(
+            "gain_db",
+            format!("must be within ±200 dB, got {}", o.gain_db),
+        ));
+    }
+    if !(o.transpose_octaves.is_finite() && o.transpose_octaves.abs() <= 6.0) {
+        return Err(invalid(
+            "transpose_octaves",
+            format!("must be within ±6 octaves, got {}", o.transpose_octaves),
+        ));
     }
     Ok(())
 }

@@ -14,6 +14,7 @@
 //! | [`envelope`] | FFT Hilbert transform and envelope ([`hilbert_envelope`]) |
 //! | [`growth`] | exponential growth/decay rates ([`fit_growth_rate`], [`growth_rate_linear_part`]) |
 //! | [`metrics`] | RMS, dominant frequency, [`Verdict`] ([`classify`]) |
+//! | [`verdict`] | the verdict of a whole run and its squeal answer ([`judge`]) |
 //! | [`audio`] | Kaiser-sinc resampling and audio clips ([`render_audio`]) |
 //!
 //! ```
@@ -43,6 +44,7 @@ pub mod metrics;
 pub mod peaks;
 pub mod spectrogram;
 pub mod spectrum;
+pub mod verdict;
 pub mod window;
 
 pub use audio::{render_audio, resample, AudioClip, AudioOptions, ResampleOptions};
@@ -60,6 +62,10 @@ pub use peaks::{find_peaks, parabolic_vertex, window_response, Peak, PeakOptions
 pub use spectrogram::{spectrogram, Spectrogram};
 pub use spectrum::{
     amplitude_spectrum, power_to_db, welch, Scaling, Spectrum, WelchOptions, DB_FLOOR,
+};
+pub use verdict::{
+    judge, Coordinate, CycleEvents, EventClass, JudgeError, JudgeOptions, Judgement, RunEvent,
+    RunRecord, RunVerdict, Squeal, Trend,
 };
 pub use window::Window;
 

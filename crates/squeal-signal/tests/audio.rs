@@ -216,3 +216,102 @@ fn audio_rejects_bad_input() {
     let amp = y[60..140].iter().fold(0.0f64, |m, v| m.max(v.abs()));
     assert!((20.0 * amp.log10()).abs() < 0.1, "{amp}");
 }
+
+/// RMS of the clip in dB re full scale, from its samples.
+fn rms_db(c: &AudioClip) -> f64 {
+    let y = as_f64(c);
+    10.0 * (y.iter().map(|v| v * v).sum::<f64>() / y.len() as f64).log10()
+}
+
+/// A fixed reference instead of normalisation: a 1 kHz sine of amplitude A (m/s) with
+/// full scale F renders at RMS `20·log10(A/(F·√2)) + gain` dB re full scale (±0.1 dB,
+/// fades included), whatever its amplitude: ten times the vibration is 20 dB louder.
+#[test]
+fn fixed_reference_renders_the_stated_level() {
+    let n = 200_000 * 3; // 3 s: no looping
+    for (amp, gain) in [(0.5, 0.0), (0.05, 0.0), (0.05, 12.0), (1.0, -6.0)] {
+        let x = tones(&[(1000.0, amp, 0.0)], FS, n);
+        let opts = AudioOptions {
+            full_scale: Some(2.0),
+            gain_db: gain,
+            ..AudioOptions::default()
+        };
+        let c = render_audio(&x, FS, &opts).unwrap();
+        let want = 20.0 * (amp / (2.0 * 2f64.sqrt())).log10() + gain;
+        assert!(
+            (rms_db(&c) - want).abs() < 0.1,
+            "A={amp} g={gain}: {} vs {want}",
+            rms_db(&c)
+        );
+        assert!((c.rms_dbfs - want).abs() < 0.1, "{} vs {want}", c.rms_dbfs);
+        assert_eq!(c.clipped, 0);
+        assert!((c.gain - 10f64.powf(gain / 20.0) / 2.0).abs() < 1e-12);
+    }
+    // Beyond full scale: clipped and counted, never wrapped.
+    let x = tones(&[(1000.0, 4.0, 0.0)], FS, n);
+    let opts = AudioOptions {
+        full_scale: Some(2.0),
+        ..AudioOptions::default()
+    };
+    let c = render_audio(&x, FS, &opts).unwrap();
+    assert!(c.clipped > 0);
+    assert!(c.samples.iter().all(|v| v.abs() <= 1.0));
+    // Bad references are refused.
+    for bad in [
+        AudioOptions {
+            full_scale: Some(0.0),
+            ..opts
+        },
+        AudioOptions {
+            gain_db: f64::NAN,
+            ..opts
+        },
+        AudioOptions {
+            transpose_octaves: 9.0,
+            ..opts
+        },
+    ] {
+        assert!(render_audio(&x, FS, &bad).is_err());
+    }
+}
+
+/// `transpose_octaves = −2` moves a 20 kHz line to 5 kHz (within one bin of the output's
+/// spectrum), resampled (no 20 kHz left, no aliases), and keeps the true-pitch duration.
+#[test]
+fn transposition_moves_the_line_and_keeps_the_duration() {
+    let n = 500_000; // 2.5 s at 200 kHz
+    let x = tones(&[(20_000.0, 0.3, 0.0)], FS, n);
+    let base = AudioOptions {
+        full_scale: Some(1.0),
+        ..AudioOptions::default()
+    };
+    let plain = render_audio(&x, FS, &base).unwrap();
+    let low = render_audio(
+        &x,
+        FS,
+        &AudioOptions {
+            transpose_octaves: -2.0,
+            ..base
+        },
+    )
+    .unwrap();
+    assert_eq!(plain.samples.len(), 120_000);
+    assert_eq!(low.samples.len(), plain.samples.len(), "duration kept");
+    assert!(!low.looped);
+    let y = as_f64(&low);
+    let opts = WelchOptions {
+        seg_len: Some(16_384),
+        ..WelchOptions::default()
+    };
+    let spec = amplitude_spectrum(&y, 48_000.0, &opts).unwrap();
+    let p = find_peaks(&spec, 1, &PeakOptions::default())[0];
+    assert!(
+        (p.freq - 5000.0).abs() <= spec.df,
+        "{} Hz (bin {})",
+        p.freq,
+        spec.df
+    );
+    // The level is kept (the same amplitude, a quarter of the frequency).
+    assert!((rms_db(&low) - rms_db(&plain)).abs() < 0.2);
+    assert!(max_db_in(&spec, 19_000.0, 21_000.0) < p.level_db - 60.0);
+}

@@ -116,3 +116,147 @@ fn classify_rejects_bad_input() {
     };
     assert!(classify_with(&x, FS, 0.0, &bad).is_err());
 }
+
+// ---- judge(): the run's verdict from named coordinates and events ----
+
+/// A one-coordinate record (`x`, `v`) sampled at `fs`.
+fn record<'a>(x: &'a [f64], v: &'a [f64], fs: f64, events: Vec<RunEvent<'a>>) -> RunRecord<'a> {
+    RunRecord {
+        sample_rate: fs,
+        t_start: 0.0,
+        coordinates: vec![Coordinate {
+            name: "x",
+            velocity_name: "v",
+            position: x,
+            velocity: v,
+        }],
+        events,
+        velocity_scale: 1.0,
+    }
+}
+
+/// `a(t)·sin(2πft)` and its integral-like position `−a(t)·cos(2πft)/(2πf)` over `secs`.
+fn osc(a: impl Fn(f64) -> f64, f: f64, fs: f64, secs: f64) -> (Vec<f64>, Vec<f64>) {
+    let n = (secs * fs) as usize;
+    let w = TAU * f;
+    let t = |i: usize| i as f64 / fs;
+    let v = (0..n).map(|i| a(t(i)) * (w * t(i)).sin()).collect();
+    let x = (0..n).map(|i| -a(t(i)) * (w * t(i)).cos() / w).collect();
+    (x, v)
+}
+
+fn word(r: &RunRecord) -> RunVerdict {
+    judge(r, &JudgeOptions::default()).unwrap().verdict
+}
+
+#[test]
+fn judge_growth_decay_neutral_and_limit_cycle() {
+    let fs = 20_000.0;
+    // σ = +1 1/s over 0.2 s: 1.7 dB in all, 0.43 dB over the window → grows.
+    let (x, v) = osc(|t| 1e-3 * t.exp(), 500.0, fs, 0.2);
+    let j = judge(&record(&x, &v, fs, vec![]), &JudgeOptions::default()).unwrap();
+    assert_eq!(j.verdict, RunVerdict::Grows, "{}", j.reason);
+    let sq = j.squeal.unwrap();
+    assert_eq!((sq.coordinate.as_str(), sq.velocity.as_str()), ("x", "v"));
+    assert!((sq.frequency_hz - 500.0).abs() < 2.5, "{}", sq.frequency_hz);
+    assert!((j.trends[0].rate - 1.0).abs() < 0.2, "{:?}", j.trends[0]);
+    // σ = −1 1/s → decays, no squeal.
+    let (x, v) = osc(|t| 1e-3 * (-t).exp(), 500.0, fs, 0.2);
+    let j = judge(&record(&x, &v, fs, vec![]), &JudgeOptions::default()).unwrap();
+    assert_eq!(j.verdict, RunVerdict::Decays, "{}", j.reason);
+    assert!(j.squeal.is_none());
+    // Constant amplitude from start to end, no events → neutral.
+    let (x, v) = osc(|_| 1e-3, 500.0, fs, 0.2);
+    assert_eq!(word(&record(&x, &v, fs, vec![])), RunVerdict::Neutral);
+    // Grew (×100) and levelled off → limit-cycle, with its squeal answer.
+    let (x, v) = osc(|t| 1e-3 * (1.0 + 99.0 * (t / 0.05).tanh()), 500.0, fs, 1.0);
+    let j = judge(&record(&x, &v, fs, vec![]), &JudgeOptions::default()).unwrap();
+    assert_eq!(j.verdict, RunVerdict::LimitCycle, "{}", j.reason);
+    let rms = j.squeal.unwrap().rms;
+    assert!((rms - 0.1 / 2f64.sqrt()).abs() < 1e-3, "{rms}");
+    // Two cycles only → too short to tell.
+    let (x, v) = osc(|_| 1e-3, 500.0, fs, 0.004);
+    assert_eq!(word(&record(&x, &v, fs, vec![])), RunVerdict::TooShort);
+}
+
+#[test]
+fn judge_stick_slip_is_the_same_at_every_sample_rate() {
+    // Sticks and slips every 1/15 s (the integrator's exact times), a bounded
+    // oscillation between them: the word and the frequency do not depend on fs.
+    let period = 1.0 / 15.0;
+    let mut events = Vec::new();
+    let mut t = 0.01;
+    while t < 2.0 {
+        events.push(RunEvent {
+            t,
+            kind: EventClass::Stick,
+            contact: None,
+        });
+        events.push(RunEvent {
+            t: t + 0.3 * period,
+            kind: EventClass::Slip,
+            contact: None,
+        });
+        t += period;
+    }
+    for fs in [100.0, 1000.0, 20_000.0] {
+        let (x, v) = osc(|_| 0.1, 15.0, fs, 2.0);
+        let j = judge(
+            &record(&x, &v, fs, events.clone()),
+            &JudgeOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(j.verdict, RunVerdict::StickSlip, "{fs} Hz: {}", j.reason);
+        let sq = j.squeal.unwrap();
+        assert!(
+            (sq.frequency_hz - 15.0).abs() < 1e-9,
+            "{fs} Hz: {}",
+            sq.frequency_hz
+        );
+        let c = j.cycle.unwrap();
+        assert!((c.sticks_per_cycle - 1.0).abs() < 0.15, "{c:?}");
+        assert_eq!(c.reversals, 0);
+    }
+}
+
+#[test]
+fn judge_out_of_range_and_lift_off() {
+    let fs = 20_000.0;
+    let (mut x, v) = osc(|_| 1e-3, 500.0, fs, 0.2);
+    x[3000] = 0.5; // half a metre: beyond the default 0.1 m
+    let j = judge(&record(&x, &v, fs, vec![]), &JudgeOptions::default()).unwrap();
+    assert_eq!(j.verdict, RunVerdict::OutOfRange);
+    assert!(
+        j.reason.contains('x') && j.reason.contains("0.150000 s"),
+        "{}",
+        j.reason
+    );
+    let wide = JudgeOptions {
+        validity: 1.0,
+        ..JudgeOptions::default()
+    };
+    assert_ne!(
+        judge(&record(&x, &v, fs, vec![]), &wide).unwrap().verdict,
+        RunVerdict::OutOfRange
+    );
+    // Separations at irregular intervals to the end → lift-off.
+    let (x, v) = osc(|_| 1e-3, 500.0, fs, 0.2);
+    let mut lcg = 12345u64;
+    let mut events = Vec::new();
+    let mut t = 0.0;
+    while t < 0.2 {
+        lcg = lcg.wrapping_mul(6364136223846793005).wrapping_add(1);
+        t += 0.002 * (0.5 + (lcg >> 11) as f64 / (1u64 << 53) as f64);
+        events.push(RunEvent {
+            t,
+            kind: EventClass::Separate,
+            contact: Some("pad"),
+        });
+        events.push(RunEvent {
+            t: t + 1e-4,
+            kind: EventClass::Contact,
+            contact: Some("pad"),
+        });
+    }
+    assert_eq!(word(&record(&x, &v, fs, events)), RunVerdict::LiftOff);
+}

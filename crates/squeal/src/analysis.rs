@@ -6,13 +6,13 @@ use crate::model::Channels;
 use crate::run::{Run, RunError};
 use crate::scenario::InputError;
 use serde_json::{json, Map, Value};
-use squeal_core::EventKind;
 use squeal_plot::{Format, HeatmapSpec, Labels, Panel, Series};
 use squeal_signal::spectrum::Scaling;
 use squeal_signal::window::Window;
 use squeal_signal::{
-    amplitude_spectrum, find_peaks, growth_rate_linear_part, spectrogram, welch, GrowthOptions,
-    Peak, PeakOptions, Spectrum, Verdict, VerdictOptions, WelchOptions,
+    amplitude_spectrum, find_peaks, growth_rate_linear_part, spectrogram, welch, Coordinate,
+    EventClass, GrowthOptions, JudgeOptions, Judgement, Peak, PeakOptions, RunEvent, RunRecord,
+    RunVerdict, Spectrum, WelchOptions,
 };
 use std::fmt::Write as _;
 use std::path::Path;
@@ -41,14 +41,18 @@ pub struct ChannelSpectrum {
 /// Spectra, growth and verdict of a run.
 #[derive(Debug, Clone)]
 pub struct Analysis {
+    /// Spectrum of every analysed velocity (all of the state's, or `--signals`), column order.
+    pub spectra: Vec<ChannelSpectrum>,
     /// Tangential velocity spectrum.
     pub tangential: Option<ChannelSpectrum>,
     /// Normal velocity spectrum.
     pub normal: Option<ChannelSpectrum>,
     /// Growth rate of each velocity over its exponential part: (signal, rate 1/s, t0, t1, R²).
     pub growth: Vec<(String, f64, f64, f64, f64)>,
-    /// One word: decays, grows, limit-cycle, stick-slip.
-    pub verdict: Verdict,
+    /// The run's word ([`RunVerdict`]); the same as `judgement.verdict`.
+    pub verdict: RunVerdict,
+    /// The verdict with its reasons, trends, squeal answer and events per cycle.
+    pub judgement: Judgement,
 }
 
 /// The spectral analyser's settings (the thesis's analyser had a sample time,
@@ -121,42 +125,108 @@ fn spectrum_of(name: &str, x: &[f64], fs: f64, set: &SpectrumSettings) -> Option
     } else {
         welch(x, fs, &opts).ok()?
     };
-    // Peaks within 60 dB of the strongest: below that lies the numerical noise floor.
-    let peaks = find_peaks(
-        &spectrum,
+    Some(ChannelSpectrum {
+        signal: name.to_string(),
+        spectrum,
+        peaks: Vec::new(),
+        segment: set.segment.min(x.len()),
+    })
+}
+
+/// How far (dB) below the run's strongest spectral line the numerical noise
+/// floor lies: the integrator's relative accuracy (rtol ≈ 1e-8) is 160 dB in
+/// power. Nothing below it is labelled a peak.
+pub const NOISE_DB: f64 = 160.0;
+
+/// A peak must stand this many dB above its own spectrum's median level.
+pub const PROMINENCE_DB: f64 = 20.0;
+
+/// The strongest peaks (at most 5, within 60 dB of the spectrum's strongest)
+/// that are lines, not noise: above the run's noise floor (`run_max_db −
+/// NOISE_DB`) and [`PROMINENCE_DB`] above the spectrum's median level.
+fn real_peaks(c: &ChannelSpectrum, run_max_db: f64) -> Vec<Peak> {
+    let db = c.spectrum.to_db();
+    let mut sorted: Vec<f64> = db.iter().copied().filter(|v| v.is_finite()).collect();
+    if sorted.is_empty() {
+        return Vec::new();
+    }
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    find_peaks(
+        &c.spectrum,
         5,
         &PeakOptions {
             max_below_strongest_db: 60.0,
             ..PeakOptions::default()
         },
-    );
-    Some(ChannelSpectrum {
-        signal: name.to_string(),
-        spectrum,
-        peaks,
-        segment: set.segment.min(x.len()),
-    })
+    )
+    .into_iter()
+    .filter(|p| p.level_db >= run_max_db - NOISE_DB && p.level_db >= median + PROMINENCE_DB)
+    .collect()
+}
+
+/// The state's velocity columns of a run (`vx_d, vx_p, vy_d, vy_p`; the belt's `v`).
+pub fn velocity_columns(run: &Run) -> Vec<String> {
+    let mut v: Vec<String> = state_pairs(run).into_iter().map(|p| p.1).collect();
+    // Column order (velocities as the run lists them).
+    v.sort_by_key(|n| run.columns.iter().position(|c| c == n));
+    v
+}
+
+/// Check a `--signals` list against a run's velocities (one line naming the bad one).
+pub fn check_signals(signals: &[String], velocities: &[String]) -> Result<(), InputError> {
+    for s in signals {
+        if !velocities.contains(s) {
+            return Err(InputError(format!(
+                "--signals {s}: no such velocity (velocities: {})",
+                velocities.join(", ")
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Analyse a run. Velocities are the columns whose names start with `v`.
-pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
+///
+/// `validity` is the scenario's displacement bound (m) for `out-of-range`.
+pub fn analyse(
+    run: &Run,
+    ch: &Channels,
+    set: &SpectrumSettings,
+    validity: f64,
+    signals: &[String],
+) -> Analysis {
     let fs = run.sample_rate;
-    let tangential = run
-        .column(ch.tangential)
-        .and_then(|x| spectrum_of(ch.tangential, x, fs, set));
-    let normal = ch
-        .normal
-        .and_then(|n| run.column(n).and_then(|x| spectrum_of(n, x, fs, set)));
-    let t_end = run
-        .column("t")
-        .and_then(|t| t.last().copied())
-        .unwrap_or(0.0);
-    let tail_start = 0.75 * t_end;
-    let stick_slip_in_tail = run
-        .events
+    let names: Vec<String> = if signals.is_empty() {
+        velocity_columns(run)
+    } else {
+        signals.to_vec()
+    };
+    let mut spectra: Vec<ChannelSpectrum> = names
         .iter()
-        .any(|(t, k)| *t >= tail_start && matches!(k, EventKind::Stick | EventKind::Reverse));
-    let stick_flag = if stick_slip_in_tail { 1.0 } else { 0.0 };
+        .filter_map(|n| run.column(n).and_then(|x| spectrum_of(n, x, fs, set)))
+        .collect();
+    let run_max_db = spectra
+        .iter()
+        .flat_map(|c| c.spectrum.to_db())
+        .fold(f64::NEG_INFINITY, f64::max);
+    for c in &mut spectra {
+        c.peaks = real_peaks(c, run_max_db);
+    }
+    let named = |n: Option<&str>| {
+        n.and_then(|n| {
+            spectra.iter().find(|c| c.signal == n).cloned().or_else(|| {
+                run.column(n).and_then(|x| {
+                    spectrum_of(n, x, fs, set).map(|mut c| {
+                        c.peaks = real_peaks(&c, run_max_db);
+                        c
+                    })
+                })
+            })
+        })
+    };
+    let tangential = named(Some(ch.tangential));
+    let normal = named(ch.normal);
     let mut growth = Vec::new();
     for (name, col) in run.columns.iter().zip(&run.data) {
         if !name.starts_with('v') || name == "v_rel" {
@@ -174,62 +244,93 @@ pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
             }
         }
     }
-    // The verdict is about the friction-excited (tangential) motion; only when
-    // there is none (a disc at rest) does it describe the normal motion; when
-    // nothing moves by more than STILL·V (a run started exactly at a stable
-    // equilibrium, where only integration noise remains) it decays. A
-    // steady tail is one whose level changes by less than 0.25 dB: slow decays
-    // (the disc's ≈ 0.5 1/s) must not pass for limit cycles.
-    let opts = VerdictOptions {
-        steady_tol_db: 0.25,
-        ..VerdictOptions::default()
-    };
-    let speed = run
-        .column("v_rel")
-        .map_or(0.0, |v| v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
-    let still = STILL * speed.max(1e-3);
-    let moving = |name: &str| {
-        run.column(name)
-            .is_some_and(|x| x.iter().any(|v| v.abs() > still))
-    };
-    let velocity = |name: &str| name.starts_with('v') && name != "v_rel";
-    let tangential_cols: Vec<&String> = run
-        .columns
-        .iter()
-        .filter(|n| velocity(n) && (n.starts_with("vx") || n.as_str() == "v") && moving(n))
-        .collect();
-    let chosen: Vec<&String> = if tangential_cols.is_empty() {
-        run.columns
-            .iter()
-            .filter(|n| velocity(n) && moving(n))
-            .collect()
-    } else {
-        tangential_cols
-    };
-    let verdicts: Vec<Verdict> = chosen
-        .iter()
-        .filter_map(|n| run.column(n))
-        .filter_map(|x| squeal_signal::classify_with(x, fs, stick_flag, &opts).ok())
-        .map(|c| c.verdict)
-        .collect();
-    // The system's verdict: growing anywhere beats a steady oscillation, which beats decay.
-    let verdict = if verdicts.contains(&Verdict::Grows) {
-        Verdict::Grows
-    } else if verdicts.contains(&Verdict::StickSlip)
-        || (stick_slip_in_tail && verdicts.contains(&Verdict::LimitCycle))
-    {
-        Verdict::StickSlip
-    } else if verdicts.contains(&Verdict::LimitCycle) {
-        Verdict::LimitCycle
-    } else {
-        Verdict::Decays
-    };
+    let judgement = judge_run(run, validity);
+    let verdict = judgement.verdict;
     Analysis {
+        spectra,
         tangential,
         normal,
         growth,
         verdict,
+        judgement,
     }
+}
+
+/// The state's coordinates of a run by name: every column `q` with a velocity
+/// column `vq` (`x_p` and `vx_p`; the belt's `x` has `v`), in column order.
+pub fn state_pairs(run: &Run) -> Vec<(String, String)> {
+    let has = |n: &str| run.columns.iter().any(|c| c == n);
+    run.columns
+        .iter()
+        .skip(1)
+        .filter_map(|c| {
+            let v = format!("v{c}");
+            if has(&v) {
+                Some((c.clone(), v))
+            } else if c == "x" && has("v") {
+                Some((c.clone(), "v".to_string()))
+            } else {
+                None
+            }
+        })
+        .collect()
+}
+
+/// The run's events as the verdict sees them.
+pub fn run_events(run: &Run) -> Vec<RunEvent<'static>> {
+    run.events
+        .iter()
+        .filter_map(|(t, k)| {
+            EventClass::from_name(k.as_str()).map(|kind| RunEvent {
+                t: *t,
+                kind,
+                contact: None,
+            })
+        })
+        .collect()
+}
+
+/// [`squeal_signal::judge`] on a run: every coordinate, every event, the
+/// scenario's validity bound; the velocity scale is the largest sliding speed.
+pub fn judge_run(run: &Run, validity: f64) -> Judgement {
+    let pairs = state_pairs(run);
+    let coordinates: Vec<Coordinate> = pairs
+        .iter()
+        .filter_map(|(p, v)| {
+            Some(Coordinate {
+                name: p,
+                velocity_name: v,
+                position: run.column(p)?,
+                velocity: run.column(v)?,
+            })
+        })
+        .collect();
+    let speed = run
+        .column("v_rel")
+        .map_or(0.0, |v| v.iter().fold(0.0f64, |m, x| m.max(x.abs())));
+    let record = RunRecord {
+        sample_rate: run.sample_rate,
+        t_start: run
+            .column("t")
+            .and_then(|t| t.first().copied())
+            .unwrap_or(0.0),
+        coordinates,
+        events: run_events(run),
+        velocity_scale: speed,
+    };
+    let opts = JudgeOptions {
+        validity,
+        still: STILL,
+        ..JudgeOptions::default()
+    };
+    squeal_signal::judge(&record, &opts).unwrap_or_else(|e| Judgement {
+        verdict: RunVerdict::TooShort,
+        reason: e.to_string(),
+        window: (0.0, 0.0),
+        trends: Vec::new(),
+        squeal: None,
+        cycle: None,
+    })
 }
 
 fn channel_json(c: &Option<ChannelSpectrum>) -> Value {
@@ -253,12 +354,17 @@ fn channel_json(c: &Option<ChannelSpectrum>) -> Value {
 impl Analysis {
     /// The `spectrum` key of summary.json.
     pub fn spectrum_json(&self) -> Value {
-        let df = self
-            .tangential
-            .as_ref()
-            .or(self.normal.as_ref())
-            .map(|c| c.spectrum.df);
-        let first = self.tangential.as_ref().or(self.normal.as_ref());
+        let first = self
+            .spectra
+            .first()
+            .or(self.tangential.as_ref())
+            .or(self.normal.as_ref());
+        let df = first.map(|c| c.spectrum.df);
+        let mut signals = Map::new();
+        for c in &self.spectra {
+            let v = self.with_growth(channel_json(&Some(c.clone())), &Some(c.clone()));
+            signals.insert(c.signal.clone(), v);
+        }
         json!({
             "window": first.map(|c| c.spectrum.window.name()),
             "segment": first.map(|c| c.segment),
@@ -267,6 +373,7 @@ impl Analysis {
             "resolution_hz": df,
             "tangential": self.with_growth(channel_json(&self.tangential), &self.tangential),
             "normal": self.with_growth(channel_json(&self.normal), &self.normal),
+            "signals": signals,
         })
     }
     /// A channel's JSON with the growth rate (1/s) of its signal added.
@@ -276,6 +383,90 @@ impl Analysis {
             obj.insert("growth_rate".into(), json!(g));
         }
         v
+    }
+
+    /// The `squeal` key of summary.json: `{coordinate, frequency_hz, rms,
+    /// level_db}` (position name, Hz, velocity RMS in m/s over the judged
+    /// window, dB re 1 m/s), or `null` when nothing squeals.
+    pub fn squeal_json(&self) -> Value {
+        match &self.judgement.squeal {
+            None => Value::Null,
+            Some(s) => json!({
+                "coordinate": s.coordinate,
+                "velocity": s.velocity,
+                "frequency_hz": s.frequency_hz,
+                "rms": s.rms,
+                "level_db": s.level_db,
+            }),
+        }
+    }
+
+    /// The `verdict_detail` key of summary.json: why the verdict, over which
+    /// window, and (when the run squeals) its events per cycle: true sticks,
+    /// slip reversals, separations.
+    pub fn verdict_detail_json(&self) -> Value {
+        let j = &self.judgement;
+        let trends: Map<String, Value> = j
+            .trends
+            .iter()
+            .map(|t| {
+                (
+                    t.name.clone(),
+                    json!({
+                        "rms": t.rms,
+                        "rate": if t.rate_se.is_finite() { json!(t.rate) } else { Value::Null },
+                        "rate_se": if t.rate_se.is_finite() { json!(t.rate_se) } else { Value::Null },
+                        "change_db": if t.rate_se.is_finite() { json!(t.change_db) } else { Value::Null },
+                        "below_peak_db": t.below_peak_db,
+                        "moving": t.moving,
+                    }),
+                )
+            })
+            .collect();
+        let cycle = j.cycle.map_or(Value::Null, |c| {
+            json!({
+                "cycles": c.cycles,
+                "sticks": c.sticks,
+                "reversals": c.reversals,
+                "separations": c.separations,
+                "sticks_per_cycle": c.sticks_per_cycle,
+                "reversals_per_cycle": c.reversals_per_cycle,
+                "separations_per_cycle": c.separations_per_cycle,
+            })
+        });
+        json!({
+            "verdict": j.verdict.as_str(),
+            "reason": j.reason,
+            "window_s": [j.window.0, j.window.1],
+            "per_cycle": cycle,
+            "trends": trends,
+        })
+    }
+
+    /// The squeal answer in words, for the terminal: "squeals at 20.75 kHz
+    /// (x_p, vx_p RMS 0.708 m/s = −3.0 dB re 1 m/s)", or what the verdict says
+    /// instead.
+    pub fn squeal_line(&self, coordinate_words: impl Fn(&str) -> Option<&'static str>) -> String {
+        let j = &self.judgement;
+        match &j.squeal {
+            Some(s) => {
+                let what = coordinate_words(&s.coordinate)
+                    .map_or(s.coordinate.clone(), |w| format!("{w}, {}", s.coordinate));
+                let verb = if j.verdict == RunVerdict::Grows {
+                    "squeals (still growing)"
+                } else {
+                    "squeals"
+                };
+                format!(
+                    "{verb} at {} ({what}): {} RMS = {:.1} dB re 1 m/s; verdict {}",
+                    si(s.frequency_hz, "Hz", 4),
+                    si(s.rms, "m/s", 3),
+                    s.level_db,
+                    j.verdict
+                )
+            }
+            None => format!("does not squeal: verdict {} ({})", j.verdict, j.reason),
+        }
     }
 
     /// The `growth_rate` key of summary.json: per velocity, rate (1/s) and window (s).
@@ -295,7 +486,7 @@ impl Analysis {
 /// spectrum (`<signal>_psd` in (m/s)²/Hz, or `<signal>_amp2` in (m/s)² with
 /// `--amplitude`) and the same in dB (`<signal>_db`).
 pub fn write_spectrum_csv(an: &Analysis, path: &Path) -> Result<(), RunError> {
-    let chans: Vec<&ChannelSpectrum> = [&an.tangential, &an.normal].into_iter().flatten().collect();
+    let chans: Vec<&ChannelSpectrum> = an.spectra.iter().collect();
     let Some(first) = chans.first() else {
         return Ok(());
     };
@@ -326,86 +517,219 @@ pub fn write_spectrum_csv(an: &Analysis, path: &Path) -> Result<(), RunError> {
         .map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))
 }
 
-/// Write the pictures of a run into `dir`: `triplet` (the thesis's three
-/// pictures), `spectrogram` and `phase` (pad tangential phase portrait), as
-/// PNG and SVG.
+/// What the pictures show beyond the analyser's settings.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PlotSettings {
+    /// Frequency range (Hz) of the spectra and the spectrogram; `None`: all.
+    pub f_range: Option<(f64, f64)>,
+    /// Logarithmic frequency axes.
+    pub log_f: bool,
+}
+
+impl PlotSettings {
+    /// From `--fmax F`, `--frange LO:HI` and `--log-f`, checked (at most one range).
+    pub fn from_flags(
+        fmax: Option<f64>,
+        frange: Option<&str>,
+        log_f: bool,
+    ) -> Result<Self, InputError> {
+        let f_range = match (fmax, frange) {
+            (Some(_), Some(_)) => {
+                return Err(InputError(
+                    "--fmax and --frange: give one frequency range, not both".into(),
+                ))
+            }
+            (Some(f), None) => {
+                if !(f.is_finite() && f > 0.0) {
+                    return Err(InputError(format!("--fmax {f}: must be a number > 0 (Hz)")));
+                }
+                Some((0.0, f))
+            }
+            (None, Some(r)) => {
+                let bad = || {
+                    InputError(format!(
+                        "--frange {r}: expected LO:HI in Hz with 0 <= LO < HI"
+                    ))
+                };
+                let (lo, hi) = r.split_once(':').ok_or_else(bad)?;
+                let lo: f64 = lo.trim().parse().map_err(|_| bad())?;
+                let hi: f64 = hi.trim().parse().map_err(|_| bad())?;
+                if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && lo < hi) {
+                    return Err(bad());
+                }
+                Some((lo, hi))
+            }
+            (None, None) => None,
+        };
+        Ok(PlotSettings { f_range, log_f })
+    }
+}
+
+/// A prefix scale for values up to `max_abs`: (divisor, prefix) such that the
+/// scaled values lie in [1, 1000) — "µ" for 3e-6.
+pub fn si_scale(max_abs: f64) -> (f64, &'static str) {
+    const P: [(f64, &str); 9] = [
+        (1e9, "G"),
+        (1e6, "M"),
+        (1e3, "k"),
+        (1.0, ""),
+        (1e-3, "m"),
+        (1e-6, "µ"),
+        (1e-9, "n"),
+        (1e-12, "p"),
+        (1e-15, "f"),
+    ];
+    if !(max_abs.is_finite() && max_abs > 0.0) {
+        return (1.0, "");
+    }
+    P.iter()
+        .copied()
+        .find(|(s, _)| max_abs >= *s)
+        .unwrap_or((1e-15, "f"))
+}
+
+/// Words for a velocity column: "pad tangential" for `vx_p`.
+fn velocity_words(v: &str) -> String {
+    let pos = if v == "v" {
+        "x"
+    } else {
+        v.strip_prefix('v').unwrap_or(v)
+    };
+    crate::model::coordinate_words(pos).map_or(v.to_string(), str::to_string)
+}
+
+/// Frequencies shown: (divisor, unit) — kHz when the shown range reaches 2 kHz.
+fn freq_unit(f_hi: f64) -> (f64, &'static str) {
+    if f_hi >= 2000.0 {
+        (1000.0, "kHz")
+    } else {
+        (1.0, "Hz")
+    }
+}
+
+/// Write the pictures of a run into `dir`: `triplet` (each analysed velocity
+/// against time, then its spectrum: the thesis's pictures, with the pad's
+/// velocities too), `spectrogram` (of the squealing velocity) and `phase`
+/// (phase portrait of the squealing coordinate), as PNG and SVG. Axes carry SI
+/// prefixes (µm/s, kHz); `plot` limits and scales the frequency axes.
 pub fn draw(
     run: &Run,
     an: &Analysis,
     ch: &Channels,
     title: &str,
     dir: &Path,
+    plot: &PlotSettings,
 ) -> Result<(), RunError> {
     let plot_err = |e: squeal_plot::PlotError| RunError::Io(format!("drawing failed: {e}"));
     let formats = [Format::Png, Format::Svg];
     let t = run.column("t").unwrap_or(&[]);
-    // The thesis's pictures: each velocity against time on its own axis (their
-    // sizes differ by orders of magnitude), then the spectrum of each.
-    let tan_title = format!("{title}: tangential velocity {}", ch.tangential);
-    let nor_title = format!("{title}: normal velocity {}", ch.normal.unwrap_or(""));
-    let mut panels = Vec::new();
-    if let Some(x) = run.column(ch.tangential) {
-        panels.push(
-            // One series per panel, named in its title: no legend to cover the data.
-            Panel::new(&tan_title, "time (s)", "velocity (m/s)").with_series(Series::new("", t, x)),
-        );
+    let chans: Vec<&ChannelSpectrum> = an.spectra.iter().collect();
+    // Each velocity against time on its own axis (their sizes differ by orders
+    // of magnitude), scaled to an SI prefix.
+    struct Shown {
+        title: String,
+        y_label: String,
+        y: Vec<f64>,
     }
-    if let Some(x) = ch.normal.and_then(|n| run.column(n)) {
-        panels.push(
-            Panel::new(&nor_title, "time (s)", "velocity (m/s)").with_series(Series::new("", t, x)),
-        );
-    }
-    let chans: Vec<(&ChannelSpectrum, &str)> =
-        [(&an.tangential, "tangential"), (&an.normal, "normal")]
-            .into_iter()
-            .filter_map(|(c, w)| c.as_ref().map(|c| (c, w)))
-            .collect();
-    let db: Vec<Vec<f64>> = chans.iter().map(|(c, _)| c.spectrum.to_db()).collect();
-    let titles: Vec<String> = chans
+    let time: Vec<Shown> = chans
         .iter()
-        .map(|(c, w)| {
+        .filter_map(|c| {
+            let x = run.column(&c.signal)?;
+            let m = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let (k, p) = si_scale(m);
+            Some(Shown {
+                title: format!(
+                    "{title}: {} velocity {}",
+                    velocity_words(&c.signal),
+                    c.signal
+                ),
+                y_label: format!("velocity ({p}m/s)"),
+                y: x.iter().map(|v| v / k).collect(),
+            })
+        })
+        .collect();
+    // Spectra over the chosen frequency range.
+    let f_hi_all = chans
+        .first()
+        .and_then(|c| c.spectrum.freq.last().copied())
+        .unwrap_or(1.0);
+    let (f_lo, f_hi) = plot.f_range.unwrap_or((0.0, f_hi_all));
+    let (fdiv, funit) = freq_unit(f_hi.min(f_hi_all));
+    struct Spec {
+        title: String,
+        y_label: &'static str,
+        f: Vec<f64>,
+        db: Vec<f64>,
+        peaks: Vec<(f64, String)>,
+    }
+    let specs: Vec<Spec> = chans
+        .iter()
+        .map(|c| {
             let what = if c.spectrum.scaling == Scaling::Amplitude {
                 "amplitude spectrum"
             } else {
                 "power spectral density"
             };
-            format!(
-                "{what} of {} ({w}, {} window)",
-                c.signal,
-                c.spectrum.window.name()
-            )
+            let db = c.spectrum.to_db();
+            let keep: Vec<usize> = (0..c.spectrum.freq.len())
+                .filter(|&k| {
+                    let f = c.spectrum.freq[k];
+                    f >= f_lo && f <= f_hi && (!plot.log_f || f > 0.0)
+                })
+                .collect();
+            Spec {
+                title: format!(
+                    "{what} of {} ({}, {} window)",
+                    c.signal,
+                    velocity_words(&c.signal),
+                    c.spectrum.window.name()
+                ),
+                y_label: if c.spectrum.scaling == Scaling::Amplitude {
+                    "amplitude (dB re 1 m/s)"
+                } else {
+                    "PSD (dB re 1 (m/s)²/Hz)"
+                },
+                f: keep.iter().map(|&k| c.spectrum.freq[k] / fdiv).collect(),
+                db: keep.iter().map(|&k| db[k]).collect(),
+                peaks: c
+                    .peaks
+                    .iter()
+                    .filter(|p| p.freq >= f_lo && p.freq <= f_hi)
+                    .take(2)
+                    .map(|p| (p.freq / fdiv, si(p.freq, "Hz", 4)))
+                    .collect(),
+            }
         })
         .collect();
-    let labels: Vec<Vec<String>> = chans
-        .iter()
-        .map(|(c, _)| {
-            c.peaks
-                .iter()
-                .take(2)
-                .map(|p| format!("{:.1} Hz", p.freq))
-                .collect()
-        })
-        .collect();
-    for (k, (c, _)) in chans.iter().enumerate() {
-        let y_label = if c.spectrum.scaling == Scaling::Amplitude {
-            "amplitude (dB re 1 m/s)"
-        } else {
-            "PSD (dB re 1 (m/s)²/Hz)"
-        };
-        let mut p = Panel::new(&titles[k], "frequency (Hz)", y_label).with_series(Series::new(
-            "",
-            &c.spectrum.freq,
-            &db[k],
-        ));
-        for (peak, label) in c.peaks.iter().zip(&labels[k]) {
-            p = p.with_peak(peak.freq, label);
+    let f_label = format!("frequency ({funit})");
+    let mut panels = Vec::new();
+    for s in &time {
+        // One series per panel, named in its title: no legend to cover the data.
+        panels.push(
+            Panel::new(&s.title, "time (s)", &s.y_label).with_series(Series::new("", t, &s.y)),
+        );
+    }
+    for s in &specs {
+        let mut p = Panel::new(&s.title, &f_label, s.y_label)
+            .log_x(plot.log_f)
+            .with_series(Series::new("", &s.f, &s.db));
+        for (f, label) in &s.peaks {
+            p = p.with_peak(*f, label);
         }
         panels.push(p);
     }
-    let size = (1200, 300 * panels.len() as u32);
-    squeal_plot::line_panels(dir.join("triplet"), &formats, size, &panels).map_err(plot_err)?;
+    if !panels.is_empty() {
+        let size = (1200, 300 * panels.len() as u32);
+        squeal_plot::line_panels(dir.join("triplet"), &formats, size, &panels).map_err(plot_err)?;
+    }
 
-    if let Some(x) = run.column(ch.tangential) {
+    // The spectrogram of the velocity that squeals (else the tangential one).
+    let sg_signal = an
+        .judgement
+        .squeal
+        .as_ref()
+        .map_or(ch.tangential.to_string(), |q| q.velocity.clone());
+    if let Some(x) = run.column(&sg_signal) {
         let seg = 2048.min(x.len().max(2));
         if let Ok(sg) = spectrogram(
             x,
@@ -414,40 +738,82 @@ pub fn draw(
             (seg / 4).max(1),
             squeal_signal::window::Window::Hann,
         ) {
-            let title = format!("{title}: spectrogram of {}", ch.tangential);
-            let values = transpose(&sg.psd_db, sg.n_times(), sg.n_freqs());
-            let spec = HeatmapSpec {
-                value_range: Some((sg.max_db() - 100.0, sg.max_db())),
-                ..HeatmapSpec::new(
-                    &title,
-                    "time (s)",
-                    "frequency (Hz)",
-                    "PSD (dB re 1 (m/s)²/Hz)",
-                    &sg.times,
-                    &sg.freqs,
-                    &values,
+            let title = format!(
+                "{title}: spectrogram of {sg_signal} ({})",
+                velocity_words(&sg_signal)
+            );
+            let rows: Vec<usize> = (0..sg.n_freqs())
+                .filter(|&k| {
+                    let f = sg.freqs[k];
+                    f >= f_lo && f <= f_hi && (!plot.log_f || f > 0.0)
+                })
+                .collect();
+            if rows.len() >= 2 {
+                let nt = sg.n_times();
+                let nf = sg.n_freqs();
+                let ys: Vec<f64> = rows.iter().map(|&k| sg.freqs[k] / fdiv).collect();
+                let mut values = Vec::with_capacity(rows.len() * nt);
+                for &k in &rows {
+                    for i in 0..nt {
+                        values.push(sg.psd_db[i * nf + k]);
+                    }
+                }
+                // A 100 dB scale ending at the next 10 dB above the maximum.
+                let top = (sg.max_db() / 10.0).ceil() * 10.0;
+                let spec = HeatmapSpec {
+                    value_range: Some((top - 100.0, top)),
+                    log_y: plot.log_f,
+                    ..HeatmapSpec::new(
+                        &title,
+                        "time (s)",
+                        &f_label,
+                        "PSD (dB re 1 (m/s)²/Hz)",
+                        &sg.times,
+                        &ys,
+                        &values,
+                    )
+                };
+                squeal_plot::heatmap(
+                    dir.join("spectrogram"),
+                    &formats,
+                    squeal_plot::SIZE_SINGLE,
+                    &spec,
                 )
-            };
-            squeal_plot::heatmap(
-                dir.join("spectrogram"),
-                &formats,
-                squeal_plot::SIZE_SINGLE,
-                &spec,
-            )
-            .map_err(plot_err)?;
+                .map_err(plot_err)?;
+            }
         }
     }
-    if let (Some(x), Some(v)) = (run.column(ch.phase.0), run.column(ch.phase.1)) {
+    // The phase portrait of the squealing coordinate (else the model's default).
+    let (px, pv) = an
+        .judgement
+        .squeal
+        .as_ref()
+        .map_or((ch.phase.0.to_string(), ch.phase.1.to_string()), |q| {
+            (q.coordinate.clone(), q.velocity.clone())
+        });
+    if let (Some(x), Some(v)) = (run.column(&px), run.column(&pv)) {
         // The last fifth of the run: the settled motion (a stick line, if any, is flat at v = V).
         let from = x.len() - x.len() / 5;
         let (x, v) = (&x[from..], &v[from..]);
         let t_from = t.get(from).copied().unwrap_or(0.0);
+        // Positions about their mean, both axes with SI prefixes.
+        let mean = x.iter().sum::<f64>() / x.len().max(1) as f64;
+        let xm = x.iter().fold(0.0f64, |m, a| m.max((a - mean).abs()));
+        let vm = v.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+        let (kx, ppx) = si_scale(xm);
+        let (kv, ppv) = si_scale(vm);
+        let xs: Vec<f64> = x.iter().map(|a| (a - mean) / kx).collect();
+        let vs: Vec<f64> = v.iter().map(|a| a / kv).collect();
         let title = format!(
-            "{title}: phase portrait {} – {}, t ≥ {t_from:.3} s",
-            ch.phase.0, ch.phase.1
+            "{title}: phase portrait of {} ({px} – {pv}), t ≥ {t_from:.3} s",
+            velocity_words(&pv)
         );
-        let x_label = format!("{} (m)", ch.phase.0);
-        let y_label = format!("{} (m/s)", ch.phase.1);
+        let x_label = format!(
+            "{px} − mean ({}, mean {})",
+            format_args!("{ppx}m"),
+            si(mean, "m", 4)
+        );
+        let y_label = format!("{pv} ({ppv}m/s)");
         let labels = Labels {
             title: &title,
             x_label: &x_label,
@@ -457,8 +823,8 @@ pub fn draw(
             dir.join("phase"),
             &formats,
             squeal_plot::SIZE_SINGLE,
-            x,
-            v,
+            &xs,
+            &vs,
             &labels,
         )
         .map_err(plot_err)?;
@@ -466,29 +832,171 @@ pub fn draw(
     Ok(())
 }
 
-/// Row-major (time, freq) → row-major (freq, time): heatmap rows are y.
-fn transpose(a: &[f64], n_rows: usize, n_cols: usize) -> Vec<f64> {
-    let mut out = vec![0.0; a.len()];
-    for r in 0..n_rows {
-        for c in 0..n_cols {
-            out[c * n_rows + r] = a[r * n_cols + c];
-        }
+/// `x` with an SI prefix and `digits` significant digits: `si(20751.3, "Hz", 4)`
+/// = "20.75 kHz", `si(3.2e-6, "m/s", 3)` = "3.20 µm/s".
+pub fn si(x: f64, unit: &str, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x} {unit}");
     }
-    out
+    const P: [(f64, &str); 9] = [
+        (1e9, "G"),
+        (1e6, "M"),
+        (1e3, "k"),
+        (1.0, ""),
+        (1e-3, "m"),
+        (1e-6, "µ"),
+        (1e-9, "n"),
+        (1e-12, "p"),
+        (1e-15, "f"),
+    ];
+    let a = x.abs();
+    let (scale, prefix) = P
+        .iter()
+        .copied()
+        .find(|(s, _)| a >= *s * 0.999_95)
+        .unwrap_or((1e-15, "f"));
+    let v = x / scale;
+    let int_digits = if v.abs() >= 100.0 {
+        3
+    } else if v.abs() >= 10.0 {
+        2
+    } else {
+        1
+    };
+    let dec = digits.saturating_sub(int_digits);
+    format!("{v:.dec$} {prefix}{unit}")
 }
 
-/// Render a velocity column as a WAV file (16-bit PCM or 32-bit float, 48 kHz).
-/// Returns whether the run was looped to reach the minimum length.
+/// The level reference of every WAV squeal writes: a velocity of
+/// `FULL_SCALE` m/s is full scale (sample value 1) at `--gain 0`. No
+/// normalisation: a run that vibrates ten times as fast sounds 20 dB louder.
+pub const FULL_SCALE: f64 = 2.0;
+
+/// Frequencies above this (Hz) most adults do not hear.
+pub const HEARING_LIMIT_HZ: f64 = 16_000.0;
+
+/// How a WAV is rendered: the gain on top of [`FULL_SCALE`] and a listening
+/// transposition.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SoundSettings {
+    /// Gain in dB (0: full scale = [`FULL_SCALE`] m/s).
+    pub gain_db: f64,
+    /// Transposition in octaves (0: true pitch).
+    pub transpose_octaves: f64,
+}
+
+impl SoundSettings {
+    /// From `--gain` and `--transpose`, checked.
+    pub fn from_flags(gain_db: f64, transpose: f64) -> Result<Self, InputError> {
+        if !(gain_db.is_finite() && gain_db.abs() <= 200.0) {
+            return Err(InputError(format!(
+                "--gain {gain_db}: must be a number of dB within ±200"
+            )));
+        }
+        if !(transpose.is_finite() && transpose.abs() <= 6.0) {
+            return Err(InputError(format!(
+                "--transpose {transpose}: must be a number of octaves within ±6"
+            )));
+        }
+        Ok(SoundSettings {
+            gain_db,
+            transpose_octaves: transpose,
+        })
+    }
+    /// The line that says how loud the file is and why, for the terminal.
+    pub fn describe(&self, clip: &squeal_signal::AudioClip) -> String {
+        let mut s = format!(
+            "level: full scale = {FULL_SCALE} m/s at gain {:+.1} dB (no normalisation); RMS {:.1} dB re full scale",
+            self.gain_db, clip.rms_dbfs
+        );
+        if self.transpose_octaves != 0.0 {
+            let _ = write!(
+                s,
+                "; TRANSPOSED {:+} octaves (a listening aid, not the true pitch)",
+                self.transpose_octaves
+            );
+        }
+        if clip.clipped > 0 {
+            let _ = write!(
+                s,
+                "; {} samples clipped: lower --gain by {:.0} dB",
+                clip.clipped,
+                (20.0 * (1.0 / clip.gain.max(1e-300)).log10())
+                    .max(6.0)
+                    .ceil()
+            );
+        }
+        s
+    }
+    /// The same as JSON (`audio` in summary.json).
+    pub fn json(&self, signal: &str, clip: &squeal_signal::AudioClip) -> Value {
+        json!({
+            "signal": signal,
+            "full_scale_m_per_s": FULL_SCALE,
+            "gain_db": self.gain_db,
+            "transpose_octaves": self.transpose_octaves,
+            "rms_dbfs": clip.rms_dbfs,
+            "clipped_samples": clip.clipped,
+            "sample_rate": clip.sample_rate,
+            "seconds": clip.duration(),
+        })
+    }
+}
+
+/// The velocity to hear by default: the squealing one, else the state's
+/// velocity with the most energy (largest RMS over the judged window).
+pub fn default_sound_signal(run: &Run, j: &Judgement) -> Option<String> {
+    if let Some(q) = &j.squeal {
+        return Some(q.velocity.clone());
+    }
+    let pairs = state_pairs(run);
+    j.trends
+        .iter()
+        .filter(|t| t.rms > 0.0)
+        .max_by(|a, b| a.rms.total_cmp(&b.rms))
+        .and_then(|t| pairs.iter().find(|p| p.0 == t.name).map(|p| p.1.clone()))
+        .or_else(|| pairs.first().map(|p| p.1.clone()))
+}
+
+/// A note when the squeal is above most adults' hearing, offering the
+/// listening aid.
+pub fn hearing_note(j: &Judgement, sound: &SoundSettings) -> Option<String> {
+    let q = j.squeal.as_ref()?;
+    if q.frequency_hz <= HEARING_LIMIT_HZ || sound.transpose_octaves != 0.0 {
+        return None;
+    }
+    Some(format!(
+        "note: the squeal ({}) is above most adults' hearing (about {}); to hear what the brake does, \
+         render it two octaves lower with --transpose -2 (at {}; a listening aid, not the true pitch)",
+        si(q.frequency_hz, "Hz", 4),
+        si(HEARING_LIMIT_HZ, "Hz", 2),
+        si(q.frequency_hz / 4.0, "Hz", 4)
+    ))
+}
+
+/// Render a velocity column as a WAV file (16-bit PCM or 32-bit float, 48 kHz)
+/// at the fixed level reference ([`FULL_SCALE`], `sound.gain_db`), at true
+/// pitch unless transposed. The resampler passes up to 22 kHz, so the disc–pad
+/// squeal at 20.75 kHz is in the file, not filtered out.
 pub fn write_wav(
     x: &[f64],
     fs: f64,
     path: &Path,
     float: bool,
+    sound: &SoundSettings,
 ) -> Result<squeal_signal::AudioClip, RunError> {
     // Loop the last fifth: the part the verdict judges steady (the last half of
     // a squeal run often still holds its growth or the pad's saturation).
     let opts = squeal_signal::AudioOptions {
         loop_fraction: 0.2,
+        full_scale: Some(FULL_SCALE),
+        gain_db: sound.gain_db,
+        transpose_octaves: sound.transpose_octaves,
+        resampler: squeal_signal::ResampleOptions {
+            passband_hz: 22_000.0,
+            stopband_hz: 24_000.0,
+            ..squeal_signal::ResampleOptions::default()
+        },
         ..squeal_signal::AudioOptions::default()
     };
     let clip = squeal_signal::render_audio(x, fs, &opts)
@@ -514,5 +1022,41 @@ pub fn write_wav(
         }
     }
     w.finalize().map_err(io)?;
+    let comment = format!(
+        "squeal: {}; full scale = {FULL_SCALE} m/s at gain {:+.1} dB; transposed {:+} octaves",
+        path.file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+        sound.gain_db,
+        sound.transpose_octaves
+    );
+    append_wav_comment(path, &comment)
+        .map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))?;
     Ok(clip)
+}
+
+/// Append a RIFF `LIST`/`INFO` chunk with an `ICMT` (comment) entry to a WAV
+/// file and fix the RIFF size: players show it as the file's comment.
+fn append_wav_comment(path: &Path, text: &str) -> std::io::Result<()> {
+    use std::io::{Seek, SeekFrom, Write};
+    let mut body = text.as_bytes().to_vec();
+    body.push(0);
+    if body.len() % 2 == 1 {
+        body.push(0);
+    }
+    let mut chunk = Vec::with_capacity(body.len() + 20);
+    chunk.extend_from_slice(b"LIST");
+    chunk.extend_from_slice(&((4 + 8 + body.len()) as u32).to_le_bytes());
+    chunk.extend_from_slice(b"INFO");
+    chunk.extend_from_slice(b"ICMT");
+    chunk.extend_from_slice(&(body.len() as u32).to_le_bytes());
+    chunk.extend_from_slice(&body);
+    let mut f = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(path)?;
+    let len = f.seek(SeekFrom::End(0))?;
+    f.write_all(&chunk)?;
+    f.seek(SeekFrom::Start(4))?;
+    f.write_all(&((len + chunk.len() as u64 - 8) as u32).to_le_bytes())?;
+    f.flush()
 }

@@ -15,6 +15,7 @@ mod scenario;
 #[cfg(test)]
 mod scenario_props;
 mod staging;
+mod study;
 
 use clap::{Args, Parser, Subcommand};
 use run::RunError;

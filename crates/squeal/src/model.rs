@@ -127,3 +127,16 @@ pub fn channels_for(model: &str) -> Channels {
         },
     }
 }
+
+/// Words for a coordinate, for the terminal ("pad tangential" for `x_p`).
+pub fn coordinate_words(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "x_d" => "disc tangential",
+        "x_p" => "pad tangential",
+        "y_d" => "disc normal",
+        "y_p" => "pad normal",
+        "x" => "tangential",
+        "y" => "normal",
+        _ => return None,
+    })
+}

@@ -29,6 +29,10 @@ pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
 /// Most samples a run may write (guards memory against a typo in `sample_rate`).
 pub const MAX_SAMPLES: f64 = 5.0e7;
 
+/// Default validity bound (m): a tenth of a metre, far beyond any elastic
+/// deflection a lumped brake or belt model describes.
+pub const VALIDITY: f64 = 0.1;
+
 /// A resolved, validated scenario.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scenario {
@@ -42,6 +46,9 @@ pub struct Scenario {
     pub duration: f64,
     /// Output sample rate (Hz).
     pub sample_rate: f64,
+    /// Largest displacement (m) the model means anything at: a run whose
+    /// positions go beyond it is judged `out-of-range` (default [`VALIDITY`]).
+    pub validity: f64,
     /// Initial state before offsets.
     pub initial: Initial,
     /// Offsets added to the initial state, one per state.
@@ -116,6 +123,7 @@ impl Scenario {
             model,
             duration: 0.5,
             sample_rate: 200_000.0,
+            validity: VALIDITY,
             initial: Initial::Rest,
             solver: SolverOptions::default(),
         };
@@ -266,6 +274,7 @@ impl Scenario {
             model,
             duration: 0.5,
             sample_rate: 200_000.0,
+            validity: VALIDITY,
             initial: Initial::Rest,
             solver: SolverOptions::default(),
         };
@@ -301,7 +310,8 @@ impl Scenario {
                     return err(format!("{key} = {v}: expected a table [{key}]"))
                 }
                 (
-                    "duration" | "sample_rate" | "initial" | "contact" | "name" | "description",
+                    "duration" | "sample_rate" | "validity" | "initial" | "contact" | "name"
+                    | "description",
                     v,
                 ) => {
                     let setting = Setting::from_toml(v)
@@ -344,8 +354,8 @@ impl Scenario {
     /// Apply one flat key (the `--set` namespace).
     pub fn apply(&mut self, key: &str, value: &Setting) -> Result<(), InputError> {
         let section = match key {
-            "friction" | "initial" | "contact" | "duration" | "sample_rate" | "name"
-            | "description" => "",
+            "friction" | "initial" | "contact" | "duration" | "sample_rate" | "validity"
+            | "name" | "description" => "",
             "rtol" | "atol_pos" | "atol_vel" | "h_max" => "solver",
             k if self.atol_index(k).is_some() => "solver",
             k if self.offset_index(k).is_some() => "offsets",
@@ -479,6 +489,15 @@ impl Scenario {
                 }
                 self.sample_rate = x;
             }
+            ("", "validity") => {
+                let x = number(value)?;
+                if !(x.is_finite() && x > 0.0) {
+                    return err(format!(
+                        "validity = {x}: must be a finite number > 0 (m, the largest displacement the model means)"
+                    ));
+                }
+                self.validity = x;
+            }
             ("solver", "rtol") => {
                 let x = number(value)?;
                 if !(1e-14..=1e-2).contains(&x) {
@@ -607,6 +626,7 @@ impl Scenario {
             "model": self.model.name(),
             "duration": self.duration,
             "sample_rate": self.sample_rate,
+            "validity": self.validity,
             "initial": self.initial.as_str(),
             "params": params,
             "friction": friction,
@@ -648,6 +668,10 @@ impl Scenario {
             t,
             "# (offsets as --set x_d0=1e-9, solver keys as --set rtol=1e-10)."
         );
+        let _ = writeln!(
+            t,
+            "# The equations, friction laws and the origin of every default: docs/physics.md"
+        );
         let _ = writeln!(t);
         line(
             &mut t,
@@ -674,6 +698,11 @@ impl Scenario {
             &mut t,
             format!("sample_rate = {:?}", self.sample_rate),
             "Hz, uniform output sampling",
+        );
+        line(
+            &mut t,
+            format!("validity = {:?}", self.validity),
+            "m, largest displacement the model means (beyond it: verdict out-of-range)",
         );
         line(
             &mut t,

@@ -257,6 +257,19 @@ fn shown_scenario_reproduces_the_default_run() {
         text.contains("k_dx = 1000000000.0") && text.contains("# N/m"),
         "documented: {text}"
     );
+    // The equations live in the repository, and the shown file says where.
+    assert!(text.contains("docs/physics.md"), "{text}");
+    let physics = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/physics.md");
+    let doc = std::fs::read_to_string(&physics).unwrap();
+    for must in [
+        "F_y = k_py",
+        "v = V + ẋ_d − ẋ_p",
+        "F_f = α·F_t·y_d",
+        "μ_s·F_y / k_px",
+        "**reconstruction**",
+    ] {
+        assert!(doc.contains(must), "docs/physics.md lacks {must}");
+    }
     for (args, dir) in [
         (vec!["simulate", "--out", "a"], "a"),
         (vec!["simulate", "f.toml", "--out", "b"], "b"),

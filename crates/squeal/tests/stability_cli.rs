@@ -148,7 +148,22 @@ fn transient_map_classifies_by_simulation() {
         } else if sigma > 0.05 {
             assert!(outcome == "stick-slip" || outcome == "grows", "{line}");
         }
+        // The agree column is never empty.
+        assert!(["yes", "no", "n/a"].contains(&f[8]), "{line}");
     }
+    // Drawn as outcome classes with a legend, not a colour scale.
+    let svg = std::fs::read_to_string(d.path().join("t/transient.svg")).unwrap();
+    for class in [
+        "decays",
+        "grows",
+        "stick-slip",
+        "steady",
+        "out-of-range",
+        "failed",
+    ] {
+        assert!(svg.contains(class), "legend lacks {class}");
+    }
+    assert!(!svg.contains("log10 RMS"));
 }
 
 #[test]
@@ -257,4 +272,92 @@ fn stability_names_what_would_stop_the_squeal() {
         text.contains("what would stop it") && text.contains("raise V"),
         "{text}"
     );
+}
+
+#[test]
+fn a_tiny_positive_growth_rate_is_unstable_and_round_off_is_neutral() {
+    let d = tempfile::tempdir().unwrap();
+    // Just past the Hopf point in N: σ = +1.3e-4 1/s, |λ| = 1.3e5 1/s.
+    let j = json(&squeal(
+        d.path(),
+        &["stability", "--json", "--set", "N=31.91905"],
+    ));
+    let s = j["max_growth_rate"].as_f64().unwrap();
+    assert!((s - 1.302e-4).abs() < 1e-6, "{s}");
+    assert_eq!(j["stable"], false);
+    assert_eq!(j["neutral"], false);
+    assert_eq!(j["verdict"], "unstable");
+    // The same σ reached through f1 gives the same answer.
+    let j = json(&squeal(
+        d.path(),
+        &["stability", "--json", "--set", "f1=4.255874e-3"],
+    ));
+    assert_eq!(j["stable"], false);
+    // Hoffmann without damping below its coalescence: purely imaginary
+    // eigenvalues, σ = 0 within round-off: neutral, not stable, in words.
+    let args = [
+        "stability",
+        "hoffmann",
+        "--set",
+        "c1=0",
+        "--set",
+        "c2=0",
+        "--set",
+        "mu=0.2",
+    ];
+    let mut with_json = args.to_vec();
+    with_json.push("--json");
+    let j = json(&squeal(d.path(), &with_json));
+    assert_eq!(j["stable"], false);
+    assert_eq!(j["neutral"], true);
+    assert_eq!(j["verdict"], "neutral");
+    for e in j["eigenvalues"].as_array().unwrap() {
+        assert_eq!(e["neutral"], true, "{e}");
+        assert_eq!(e["growing"], false, "{e}");
+    }
+    let text = String::from_utf8_lossy(&squeal(d.path(), &args).stdout).into_owned();
+    assert!(text.contains("NEUTRAL"), "{text}");
+    // A damped brake is stable.
+    let j = json(&squeal(
+        d.path(),
+        &["stability", "--json", "--set", "c_dx=5", "--set", "c_px=5"],
+    ));
+    assert_eq!(j["stable"], true);
+    assert_eq!(j["verdict"], "stable");
+}
+
+#[test]
+fn levers_are_the_critical_values() {
+    let d = tempfile::tempdir().unwrap();
+    let j = json(&squeal(d.path(), &["stability", "--json"]));
+    let levers = j["levers"].as_array().unwrap();
+    for (p, range) in [
+        ("N", "N=1:500"),
+        ("V", "V=1:100"),
+        ("f0", "f0=0.0001:0.1"),
+        ("f1", "f1=0.00001:0.0666"),
+        ("Uc", "Uc=0.1:16.6"),
+    ] {
+        let lever = levers
+            .iter()
+            .find(|l| l["param"] == p)
+            .unwrap_or_else(|| panic!("no lever {p}: {levers:?}"))["to"]
+            .as_f64()
+            .unwrap();
+        let c = json(&squeal(d.path(), &["critical", "--param", range, "--json"]));
+        let crit = c["value"].as_f64().unwrap();
+        assert!(
+            (lever - crit).abs() <= 1e-9 * crit.abs(),
+            "{p}: lever {lever:.15e} vs critical {crit:.15e}"
+        );
+        // On the true boundary: the growth rate changes sign across it.
+        let at = |v: f64| {
+            let set = format!("{p}={v:e}");
+            json(&squeal(d.path(), &["stability", "--json", "--set", &set]))["max_growth_rate"]
+                .as_f64()
+                .unwrap()
+        };
+        let (below, above) = (at(crit * (1.0 - 1e-8)), at(crit * (1.0 + 1e-8)));
+        assert!(below * above < 0.0, "{p}: σ {below:e} / {above:e}");
+    }
 }

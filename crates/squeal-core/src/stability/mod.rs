@@ -9,33 +9,40 @@
 //! σ > 0 (thesis Ch. 1).
 //!
 //! **Neutral modes.** An undamped model has purely imaginary eigenvalues whose
-//! computed σ is round-off (≈ 1e-15·|λ|, or up to ≈ √ε·|λ| at a double
-//! eigenvalue). This module calls a mode *growing* iff
-//! `σ > NEUTRAL_TOL·|λ|` with [`NEUTRAL_TOL`] = 1e-9, and the equilibrium
-//! *unstable* iff some mode grows ([`is_growing`]). Undamped modes therefore
-//! count as stable (neutral), and the onset of mode-coupling flutter — where
-//! σ jumps from 0 to positive at the coalescence of two frequencies — is a
-//! stability change that [`critical`] locates.
+//! computed σ is round-off: the balanced QR iteration's backward error is
+//! `ε·‖B‖` (B the balanced matrix), which for the models here is below
+//! 1e-13·|λ| for every mode (≈ 1e-15·|λ| typically). This module calls a mode
+//! *neutral* iff `|σ| ≤ NEUTRAL_TOL·|λ|` with [`NEUTRAL_TOL`] = 1e-12 (of the
+//! order of that round-off, no wider), *growing* iff `σ > NEUTRAL_TOL·|λ|`
+//! ([`is_growing`]) and *damped* otherwise. The equilibrium is *stable* iff
+//! every mode is damped (every σ < 0 beyond round-off), *unstable* iff some
+//! mode grows, and *neutral* otherwise (linear analysis cannot decide). The
+//! onset of mode-coupling flutter — where σ jumps from 0 to positive at the
+//! coalescence of two undamped frequencies — is a stability change that
+//! [`critical`] locates.
 //!
 //! - [`analyse`]: all eigenvalues, eigenvectors and mode descriptions;
 //! - [`max_growth_rate`]: the fast path for stability maps (eigenvalues only,
 //!   no heap allocation, ≈ 2 µs for the 8-state disc–pad model);
 //! - [`critical`]: a grid scan plus Brent's method for the parameter value
-//!   at which the stability changes.
+//!   at which the stability changes;
+//! - [`track`]: eigenvalues followed along a parameter path.
 //!
 //! The eigen-solver is [`eigen`] (balancing + Hessenberg + Francis QR, with
 //! the reasons it is hand-written).
 
 pub mod eigen;
+pub mod track;
 
 use crate::model::{Model, ModelError};
 use crate::params::ParamError;
 use nalgebra::Complex;
 use serde::Serialize;
 
-/// Relative threshold below which a growth rate counts as zero: a mode grows
-/// iff `σ > NEUTRAL_TOL·|λ|` (see the module docs).
-pub const NEUTRAL_TOL: f64 = 1e-9;
+/// Relative threshold below which a growth rate counts as zero (round-off of
+/// the balanced eigen-solver): a mode grows iff `σ > NEUTRAL_TOL·|λ|`, is
+/// neutral iff `|σ| ≤ NEUTRAL_TOL·|λ|` (see the module docs).
+pub const NEUTRAL_TOL: f64 = 1e-12;
 
 /// Why a stability analysis failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -88,10 +95,23 @@ impl From<ModelError> for StabilityError {
     }
 }
 
+/// Round-off of σ at a (nearly) double eigenvalue, relative to |λ|: √ε. Below
+/// the coalescence of two undamped frequencies σ is 0 but its computed value
+/// can reach this; [`critical`] locates the onset of mode-coupling growth as
+/// the root of `σ_max − COALESCENCE_TOL·|λ|`.
+pub const COALESCENCE_TOL: f64 = 1.4901161193847656e-8;
+
 /// Whether an eigenvalue `re + i·im` counts as growing: `re > NEUTRAL_TOL·|λ|`.
 #[inline]
 pub fn is_growing(re: f64, im: f64) -> bool {
     re > NEUTRAL_TOL * re.hypot(im)
+}
+
+/// Whether an eigenvalue `re + i·im` is neutral: `|re| ≤ NEUTRAL_TOL·|λ|`
+/// (zero within the eigen-solver's round-off).
+#[inline]
+pub fn is_neutral(re: f64, im: f64) -> bool {
+    re.abs() <= NEUTRAL_TOL * re.hypot(im)
 }
 
 /// One eigenvalue of the state matrix and the mode it belongs to.
@@ -107,6 +127,8 @@ pub struct Eigen {
     pub damping_ratio: f64,
     /// Whether the mode grows: `σ > NEUTRAL_TOL·|λ|`.
     pub growing: bool,
+    /// Whether the mode is neutral: `|σ| ≤ NEUTRAL_TOL·|λ|` (zero within round-off).
+    pub neutral: bool,
     /// Index of the position coordinate with the largest share of the
     /// mode's energy (see [`Eigen::participation`]).
     pub dominant: usize,
@@ -142,8 +164,11 @@ pub struct Analysis {
     pub eigen: Vec<Eigen>,
     /// Largest growth rate σ_max (1/s).
     pub max_growth_rate: f64,
-    /// No mode grows (every `σ ≤ NEUTRAL_TOL·|λ|`).
+    /// Every mode is damped beyond round-off (every `σ < −NEUTRAL_TOL·|λ|`).
     pub stable: bool,
+    /// No mode grows but some mode is neutral (`|σ| ≤ NEUTRAL_TOL·|λ|`):
+    /// marginally stable, linear analysis cannot decide.
+    pub neutral: bool,
     /// Index in `eigen` of the least stable mode (0 by the sort order).
     pub least_stable: usize,
     /// The steady-sliding state `z*`.
@@ -284,6 +309,7 @@ fn analyse_impl<M: Model<N> + ?Sized, const N: usize>(
                 freq_hz: lambda.im.abs() / (2.0 * std::f64::consts::PI),
                 damping_ratio: if mag > 0.0 { -lambda.re / mag } else { 0.0 },
                 growing: is_growing(lambda.re, lambda.im),
+                neutral: is_neutral(lambda.re, lambda.im),
                 dominant,
                 dominant_name: names.get(dominant).copied().unwrap_or(""),
                 participation: e,
@@ -292,10 +318,12 @@ fn analyse_impl<M: Model<N> + ?Sized, const N: usize>(
         })
         .collect();
     modes.sort_by(|p, q| q.re.total_cmp(&p.re).then(q.im.total_cmp(&p.im)));
-    let stable = !modes.iter().any(|m| m.growing);
+    let growing = modes.iter().any(|m| m.growing);
+    let neutral = !growing && modes.iter().any(|m| m.neutral);
     Ok(Analysis {
         max_growth_rate: modes.first().map_or(f64::NEG_INFINITY, |m| m.re),
-        stable,
+        stable: !growing && !neutral,
+        neutral,
         least_stable: 0,
         equilibrium: z.to_vec(),
         eigen: modes,
@@ -363,7 +391,7 @@ pub struct Crossing {
     pub direction: Direction,
     /// The stable side is neutral (`|σ| ≤ NEUTRAL_TOL·|λ|`, undamped mode
     /// coupling): `value` is the onset of growth (coalescence of two
-    /// frequencies), located as the root of `σ_max − NEUTRAL_TOL·|λ|`.
+    /// frequencies), located as the root of `σ_max − COALESCENCE_TOL·|λ|`.
     /// Otherwise it is the root of `σ_max` (a Hopf point).
     pub from_neutral: bool,
 }
@@ -380,10 +408,12 @@ pub struct Crossing {
 ///
 /// - `g = σ_max` if the stable end is strictly damped
 ///   (`σ_max < −NEUTRAL_TOL·|λ|`): a Hopf point, found to round-off;
-/// - `g = σ_max − NEUTRAL_TOL·|λ|` if the stable end is neutral (σ_max is 0
-///   below the coalescence of an undamped mode pair and grows like the square
-///   root of the distance above it, so this root lies within ~1e-18
-///   relative of the coalescence).
+/// - `g = σ_max − COALESCENCE_TOL·|λ|` if the stable end is neutral
+///   (`|σ| ≤ NEUTRAL_TOL·|λ|`: σ_max is 0 below the coalescence of an
+///   undamped mode pair and grows like the square root of the distance above
+///   it, so this root lies within ~1e-15 relative of the coalescence). A
+///   stable end that is neutral only because a Hopf point falls on that grid
+///   point (the next grid point is strictly damped) is a Hopf point.
 ///
 /// Crossings closer together than the grid spacing may be missed.
 pub fn critical<F>(
@@ -415,17 +445,43 @@ where
     };
     let mut p0 = lo;
     let (mut s0, mut f0) = f(p0)?;
+    // The grid point before p0 (further from the bracket on the low side).
+    let mut before: Option<(f64, f64, f64)> = None;
     for i in 1..opts.grid {
         let p1 = at(i);
         let (s1, f1) = f(p1)?;
         let g0 = is_growing(s0, two_pi * f0);
         let g1 = is_growing(s1, two_pi * f1);
         if g0 != g1 {
-            let (s_stable, f_stable) = if g0 { (s1, f1) } else { (s0, f0) };
-            let neutral = s_stable >= -NEUTRAL_TOL * mag(s_stable, f_stable);
+            // The stable end, and the grid point one step further into the stable side.
+            let further = if g0 {
+                if i + 1 < opts.grid {
+                    let p = at(i + 1);
+                    let (s, fr) = f(p)?;
+                    Some((p, s, fr))
+                } else {
+                    None
+                }
+            } else {
+                before
+            };
+            let (mut a, mut sa, mut fa) = if g0 { (p1, s1, f1) } else { (p0, s0, f0) };
+            let (b, sb, fb) = if g0 { (p0, s0, f0) } else { (p1, s1, f1) };
+            let mut neutral = is_neutral(sa, two_pi * fa);
+            // A Hopf point that falls on a grid point looks neutral there (σ = 0
+            // within round-off); one step further it is strictly damped: bracket
+            // the crossing from there, on σ itself.
+            if neutral {
+                if let Some((p, s, fr)) = further {
+                    if s < -NEUTRAL_TOL * mag(s, fr) {
+                        (a, sa, fa) = (p, s, fr);
+                        neutral = false;
+                    }
+                }
+            }
             let g = |s: f64, fr: f64| {
                 if neutral {
-                    s - NEUTRAL_TOL * mag(s, fr)
+                    s - COALESCENCE_TOL * mag(s, fr)
                 } else {
                     s
                 }
@@ -435,8 +491,8 @@ where
                     let (s, fr) = f(p)?;
                     Ok(g(s, fr))
                 },
-                (p0, g(s0, f0)),
-                (p1, g(s1, f1)),
+                (a, g(sa, fa)),
+                (b, g(sb, fb)),
                 opts.rtol,
                 4.0 * f64::EPSILON * lo.abs().max(hi.abs()),
                 opts.max_iter,
@@ -453,6 +509,7 @@ where
                 from_neutral: neutral,
             }));
         }
+        before = Some((p0, s0, f0));
         (p0, s0, f0) = (p1, s1, f1);
     }
     Ok(None)

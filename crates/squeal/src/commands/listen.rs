@@ -13,9 +13,16 @@ use std::path::{Path, PathBuf};
 pub struct ListenArgs {
     #[command(flatten)]
     scenario: ScenarioArgs,
-    /// The velocity to hear (default: the disc's tangential velocity).
+    /// The velocity to hear (default: the one that squeals, else the one with the most energy).
     #[arg(long)]
     signal: Option<String>,
+    /// Gain in dB on top of the fixed reference (full scale = 2 m/s at 0 dB).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    gain: f64,
+    /// Transpose by this many octaves (e.g. -2: a 20 kHz squeal at 5 kHz), a listening aid;
+    /// resampled, duration kept.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    transpose: f64,
     /// Output WAV file (never an existing file, unless --force).
     #[arg(long, default_value = "squeal.wav")]
     out: PathBuf,
@@ -33,8 +40,9 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
     // interrupt leaves no partial file, and no file is replaced unasked.
     // Staged before the work, so an unwritable place is found at once.
     let staged = crate::staging::StagedFile::new("--out", &a.out, a.force)?;
+    let sound = analysis::SoundSettings::from_flags(a.gain, a.transpose)?;
     let dir = Path::new(&a.scenario.scenario);
-    let (run, model) = if dir.is_dir() {
+    let (run, model, validity) = if dir.is_dir() {
         if !a.scenario.sets.is_empty() {
             return Err(
                 InputError("--set applies to scenarios, not to a saved run folder".into()).into(),
@@ -45,15 +53,19 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
             .as_str()
             .unwrap_or("disc-pad")
             .to_string();
-        (run, model)
+        let validity = summary["scenario"]["validity"]
+            .as_f64()
+            .unwrap_or(crate::scenario::VALIDITY);
+        (run, model, validity)
     } else {
         let sc = crate::commands::simulate::resolve_run(&a.scenario, None)?;
-        (run::run(&sc)?, sc.model.name().to_string())
+        (run::run(&sc)?, sc.model.name().to_string(), sc.validity)
     };
-    let name = a
-        .signal
-        .clone()
-        .unwrap_or_else(|| channels_for(&model).tangential.to_string());
+    let judgement = analysis::judge_run(&run, validity);
+    let name = a.signal.clone().unwrap_or_else(|| {
+        analysis::default_sound_signal(&run, &judgement)
+            .unwrap_or_else(|| channels_for(&model).tangential.to_string())
+    });
     let x = run.column(&name).ok_or_else(|| {
         let vels: Vec<&str> = run
             .columns
@@ -66,7 +78,7 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
             vels.join(", ")
         ))
     })?;
-    let clip = analysis::write_wav(x, run.sample_rate, staged.path(), a.float)?;
+    let clip = analysis::write_wav(x, run.sample_rate, staged.path(), a.float, &sound)?;
     staged.commit("--out")?;
     if clip.looped {
         eprintln!(
@@ -75,9 +87,20 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
             clip.duration()
         );
     }
+    let what = match &judgement.squeal {
+        Some(q) if q.velocity == name => {
+            format!("the squeal, {}", analysis::si(q.frequency_hz, "Hz", 4))
+        }
+        _ => format!("verdict {}", judgement.verdict),
+    };
     crate::outln!(
-        "{}: {name} at true pitch, {:.2} s, {} Hz, {}",
+        "{}: {name} ({what}) {}, {:.2} s, {} Hz, {}",
         a.out.display(),
+        if sound.transpose_octaves == 0.0 {
+            "at true pitch".to_string()
+        } else {
+            format!("TRANSPOSED {:+} octaves", sound.transpose_octaves)
+        },
         clip.duration(),
         clip.sample_rate,
         if a.float {
@@ -86,5 +109,9 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
             "16-bit PCM"
         }
     );
+    crate::outln!("{}", sound.describe(&clip));
+    if let Some(note) = analysis::hearing_note(&judgement, &sound) {
+        eprintln!("{note}");
+    }
     Ok(())
 }

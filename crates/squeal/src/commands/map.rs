@@ -38,7 +38,7 @@ pub struct MapArgs {
     /// Output folder (default: out/SCENARIO-map).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Classify every point by simulation too (decays / grows / stick-slip / steady).
+    /// Classify every point by simulation too (decays / grows / stick-slip / steady / out-of-range).
     #[arg(long)]
     transient: bool,
     /// Simulated time per point for --transient (default: the scenario's).
@@ -168,7 +168,7 @@ pub fn linear_grid(
 /// Outcome of one transient run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outcome {
-    /// decays, grows, stick-slip, steady, or failed.
+    /// decays, grows, stick-slip, steady, out-of-range, or failed.
     pub class: &'static str,
     /// RMS of the tangential velocity over the last window (m/s).
     pub rms: f64,
@@ -195,10 +195,19 @@ struct Watch {
     event_windows: Vec<usize>,
     peak: f64,
     decided: Option<&'static str>,
+    /// The scenario's validity bound (m): a position beyond it ends the run `out-of-range`.
+    validity: f64,
 }
 
 impl<const N: usize> Sink<N> for Watch {
     fn sample(&mut self, t: f64, z: &[f64; N], _mode: Mode) -> Flow {
+        if z[..N / 2]
+            .iter()
+            .any(|q| q.is_nan() || q.abs() > self.validity)
+        {
+            self.decided = Some("out-of-range");
+            return Flow::Stop;
+        }
         let a = self.idx.iter().map(|&i| z[i].abs()).fold(0.0, f64::max);
         self.cur_max = self.cur_max.max(a);
         self.sum2 += z[self.v_idx] * z[self.v_idx];
@@ -262,6 +271,7 @@ fn transient_point<M: Model<N>, const N: usize>(
         event_windows: Vec::new(),
         peak: 0.0,
         decided: None,
+        validity: sc.validity,
     };
     // Each window's peak is taken over the scenario's samples: at 200 kHz it is
     // within a few % of the envelope, which is all a class needs.
@@ -334,23 +344,32 @@ pub fn transient_grid(
 }
 
 /// Do the linear verdict (σ) and the simulated outcome tell the same story?
-/// `yes`, `no`, or empty where either is missing.
+/// `yes` or `no`; `n/a` where there is no linear verdict (no steady sliding)
+/// or no outcome (the run failed). Never empty.
 fn agree(sigma: f64, o: &Outcome) -> &'static str {
     if !sigma.is_finite() || o.class == "failed" {
-        return "";
+        return "n/a";
     }
     let unstable = sigma > 0.0;
-    let grew = matches!(o.class, "grows" | "stick-slip");
-    let decayed = o.class == "decays";
-    if (unstable && grew) || (!unstable && decayed) {
+    // A growing, friction-limited, sustained or runaway outcome is what an
+    // unstable equilibrium predicts; decay is what a stable one predicts.
+    let sustained = matches!(o.class, "grows" | "stick-slip" | "steady" | "out-of-range");
+    if unstable == sustained {
         "yes"
-    } else if (unstable && decayed) || (!unstable && grew) {
-        "no"
     } else {
-        // "steady": neutral, or too slow to tell within the run.
-        ""
+        "no"
     }
 }
+
+/// The outcome classes of a transient map, in legend order.
+pub const CLASSES: [&str; 6] = [
+    "decays",
+    "grows",
+    "stick-slip",
+    "steady",
+    "out-of-range",
+    "failed",
+];
 
 /// A colour range for growth rates, symmetric about σ = 0, that a few
 /// extreme points (near the edge of steady sliding σ can reach 1e6 1/s) do
@@ -484,27 +503,22 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
     .map_err(plot_err)?;
     let mut disagree = 0;
     if let Some(t) = &trans {
-        let lg: Vec<f64> = t
+        let cls: Vec<f64> = t
             .iter()
-            .map(|o| if o.rms > 0.0 { o.rms.log10() } else { f64::NAN })
+            .map(|o| {
+                CLASSES
+                    .iter()
+                    .position(|c| *c == o.class)
+                    .map_or(f64::NAN, |i| i as f64)
+            })
             .collect();
-        let title = format!(
-            "{}: tangential RMS velocity at the end of each run",
-            sc.name
-        );
+        let title = format!("{}: outcome of each simulated run", sc.name);
         let spec = HeatmapSpec {
             log_x: x.log,
             log_y: y.log,
-            nan_label: "failed or exactly zero",
-            ..HeatmapSpec::new(
-                &title,
-                &xl,
-                &yl,
-                "log10 RMS velocity (m/s)",
-                &x.values,
-                &y.values,
-                &lg,
-            )
+            nan_label: "unclassified",
+            classes: &CLASSES,
+            ..HeatmapSpec::new(&title, &xl, &yl, "", &x.values, &y.values, &cls)
         };
         squeal_plot::heatmap(
             stage.path("transient"),

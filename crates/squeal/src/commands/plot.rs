@@ -19,19 +19,31 @@ pub struct PlotArgs {
 /// Run the command.
 pub fn run(a: PlotArgs) -> Result<(), RunError> {
     let settings = a.spectrum.settings()?;
-    let (run, summary) = output::read_run_dir(&a.run_dir)?;
+    let plot = a.spectrum.plot_settings()?;
+    let (run, mut summary) = output::read_run_dir(&a.run_dir)?;
+    analysis::check_signals(a.spectrum.signals(), &analysis::velocity_columns(&run))?;
     let model = summary["scenario"]["model"].as_str().unwrap_or("disc-pad");
     let name = summary["scenario"]["name"]
         .as_str()
         .unwrap_or("run")
         .to_string();
     let channels = channels_for(model);
-    let an = analysis::analyse(&run, &channels, &settings);
+    let validity = summary["scenario"]["validity"]
+        .as_f64()
+        .unwrap_or(crate::scenario::VALIDITY);
+    let an = analysis::analyse(&run, &channels, &settings, validity, a.spectrum.signals());
     // Drawn into a scratch folder first; each file then replaces only a file
     // squeal wrote (or none) in the run folder.
     let scratch = crate::staging::Staging::scratch(&a.run_dir)?;
-    analysis::draw(&run, &an, &channels, &name, scratch.dir())?;
+    analysis::draw(&run, &an, &channels, &name, scratch.dir(), &plot)?;
     analysis::write_spectrum_csv(&an, &scratch.path("spectrum.csv"))?;
+    // summary.json says what the redrawn pictures and spectrum.csv show.
+    summary["spectrum"] = an.spectrum_json();
+    summary["growth_rate"] = an.growth_json();
+    summary["verdict"] = serde_json::json!(an.verdict.as_str());
+    summary["verdict_detail"] = an.verdict_detail_json();
+    summary["squeal"] = an.squeal_json();
+    output::write_json(&summary, &scratch.path("summary.json"))?;
     crate::staging::replace_files(&a.run_dir, scratch.dir())?;
     crate::outln!(
         "pictures redrawn in {} (triplet, spectrogram, phase; PNG and SVG)",

@@ -26,7 +26,7 @@ pub struct SimulateArgs {
     /// Print summary.json on stdout instead of the human summary.
     #[arg(long)]
     json: bool,
-    /// Also write the tangential disc velocity as sound (squeal.wav, 48 kHz).
+    /// Also write the squealing velocity as sound (squeal.wav, 48 kHz, full scale = 2 m/s).
     #[arg(long)]
     wav: bool,
     /// Skip the pictures (triplet, spectrogram, phase portrait).
@@ -51,6 +51,18 @@ pub struct SpectrumArgs {
     /// Peak-amplitude spectrum instead of the power spectral density.
     #[arg(long)]
     amplitude: bool,
+    /// Velocities to analyse and draw, comma-separated (default: every velocity of the state).
+    #[arg(long, value_delimiter = ',', value_name = "NAME,…")]
+    signals: Vec<String>,
+    /// Highest frequency (Hz) shown in the spectra and the spectrogram.
+    #[arg(long)]
+    fmax: Option<f64>,
+    /// Frequency range LO:HI (Hz) shown in the spectra and the spectrogram.
+    #[arg(long, value_name = "LO:HI")]
+    frange: Option<String>,
+    /// Logarithmic frequency axes.
+    #[arg(long)]
+    log_f: bool,
 }
 
 impl SpectrumArgs {
@@ -62,6 +74,14 @@ impl SpectrumArgs {
             self.overlap,
             self.amplitude,
         )
+    }
+    /// Checked picture settings.
+    pub fn plot_settings(&self) -> Result<analysis::PlotSettings, InputError> {
+        analysis::PlotSettings::from_flags(self.fmax, self.frange.as_deref(), self.log_f)
+    }
+    /// The `--signals` list (empty: all velocities).
+    pub fn signals(&self) -> &[String] {
+        &self.signals
     }
 }
 
@@ -89,6 +109,15 @@ pub fn resolve_run(args: &ScenarioArgs, duration: Option<f64>) -> Result<Scenari
 pub fn run(a: SimulateArgs) -> Result<(), RunError> {
     let sc = resolve_run(&a.scenario, a.duration)?;
     let spectrum_settings = a.spectrum.settings()?;
+    let plot_settings = a.spectrum.plot_settings()?;
+    {
+        let names = sc.model.state_names();
+        let velocities: Vec<String> = names[names.len() / 2..]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        analysis::check_signals(a.spectrum.signals(), &velocities)?;
+    }
     let (mut csv, mut npy) = (false, false);
     for f in &a.format {
         match f.as_str() {
@@ -130,23 +159,39 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
     summary["columns"] = json!(run.columns);
     summary["rms"] = json!(output::tail_rms(&run, &velocity_names));
     let channels = sc.model.channels();
-    let an = analysis::analyse(&run, &channels, &spectrum_settings);
+    let an = analysis::analyse(
+        &run,
+        &channels,
+        &spectrum_settings,
+        sc.validity,
+        a.spectrum.signals(),
+    );
     analysis::write_spectrum_csv(&an, &stage.path("spectrum.csv"))?;
     summary["spectrum"] = an.spectrum_json();
     summary["growth_rate"] = an.growth_json();
     summary["verdict"] = json!(an.verdict.as_str());
+    summary["verdict_detail"] = an.verdict_detail_json();
+    summary["squeal"] = an.squeal_json();
     if !a.no_plots {
-        analysis::draw(&run, &an, &channels, &sc.name, stage.dir())?;
+        analysis::draw(&run, &an, &channels, &sc.name, stage.dir(), &plot_settings)?;
     }
+    let mut hearing = None;
     if a.wav {
-        if let Some(x) = run.column(channels.tangential) {
-            let clip = analysis::write_wav(x, run.sample_rate, &stage.path("squeal.wav"), false)?;
+        let sound = analysis::SoundSettings::default();
+        let signal = analysis::default_sound_signal(&run, &an.judgement)
+            .unwrap_or_else(|| channels.tangential.to_string());
+        if let Some(x) = run.column(&signal) {
+            let clip =
+                analysis::write_wav(x, run.sample_rate, &stage.path("squeal.wav"), false, &sound)?;
             if clip.looped {
                 eprintln!(
                     "note: the run ({:.3} s) is shorter than the 2 s of sound: its last steady part is looped",
                     clip.source_seconds
                 );
             }
+            summary["audio"] = sound.json(&signal, &clip);
+            eprintln!("squeal.wav: {signal}, {}", sound.describe(&clip));
+            hearing = analysis::hearing_note(&an.judgement, &sound);
         }
     }
     let output_s = t0.elapsed().as_secs_f64();
@@ -159,7 +204,11 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
             serde_json::to_string_pretty(&summary).map_err(|e| RunError::Io(e.to_string()))?
         );
     } else {
+        crate::outln!("{}", an.squeal_line(crate::model::coordinate_words));
         print_human(&sc, &run, &summary, &dest);
+    }
+    if let Some(note) = hearing {
+        eprintln!("{note}");
     }
     Ok(())
 }
@@ -195,18 +244,33 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
             parts.join(", ")
         );
     }
-    let fmt = |k: &str| {
-        summary["spectrum"][k]["dominant_hz"]
-            .as_f64()
-            .map(|f| format!("{k} {f:.1} Hz"))
-    };
-    let dom: Vec<String> = ["tangential", "normal"]
-        .iter()
-        .filter_map(|k| fmt(k))
-        .collect();
-    if !dom.is_empty() {
-        crate::outln!("dominant frequencies: {}", dom.join(", "));
+    if let Some(sig) = summary["spectrum"]["signals"].as_object() {
+        let dom: Vec<String> = sig
+            .iter()
+            .filter_map(|(k, v)| {
+                v["dominant_hz"]
+                    .as_f64()
+                    .map(|f| format!("{k} {}", crate::analysis::si(f, "Hz", 4)))
+            })
+            .collect();
+        if !dom.is_empty() {
+            crate::outln!("dominant frequencies: {}", dom.join(", "));
+        }
     }
-    crate::outln!("verdict: {}", summary["verdict"].as_str().unwrap_or("?"));
+    crate::outln!(
+        "verdict: {} — {}",
+        summary["verdict"].as_str().unwrap_or("?"),
+        summary["verdict_detail"]["reason"].as_str().unwrap_or("")
+    );
+    if let Some(c) = summary["verdict_detail"]["per_cycle"].as_object() {
+        let g = |k: &str| c.get(k).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
+        crate::outln!(
+            "per cycle of the squeal ({:.0} cycles in the judged window): {:.3} true sticks, {:.3} slip reversals, {:.3} separations",
+            g("cycles"),
+            g("sticks_per_cycle"),
+            g("reversals_per_cycle"),
+            g("separations_per_cycle")
+        );
+    }
     crate::outln!("output: {}", dest.display());
 }

@@ -48,6 +48,7 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
             json!({
                 "re": e.re, "im": e.im, "freq_hz": e.freq_hz,
                 "damping_ratio": e.damping_ratio, "dominant": e.dominant_name, "growing": e.growing,
+                "neutral": e.neutral,
             })
         })
         .collect();
@@ -62,9 +63,23 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
         "eigenvalues": eig,
         "max_growth_rate": an.max_growth_rate,
         "stable": an.stable,
+        "neutral": an.neutral,
+        "verdict": verdict_word(an),
         "least_stable": { "re": ls.re, "im": ls.im, "freq_hz": ls.freq_hz, "dominant": ls.dominant_name },
         "equilibrium": eq,
     })
+}
+
+/// `stable` (every σ < 0 beyond round-off), `neutral` (no mode grows, some
+/// mode has σ = 0 within round-off) or `unstable`.
+pub fn verdict_word(an: &Analysis) -> &'static str {
+    if an.stable {
+        "stable"
+    } else if an.neutral {
+        "neutral"
+    } else {
+        "unstable"
+    }
 }
 
 /// One parameter change that alone flips the verdict (all else as is).
@@ -117,17 +132,51 @@ pub fn levers(model: &AnyModel) -> Vec<Lever> {
                 ..CriticalOptions::default()
             };
             if let Ok(Some(c)) = stability::critical(f, 0.0, 1.0, &opts) {
+                let rough = a + c.value * (b - a);
+                // The scan's root is exact in s, i.e. to 1e-10·|b − a| in the
+                // parameter; refine it on the parameter itself, with the same
+                // Brent iteration and tolerance as `critical`, so a lever and
+                // `squeal critical` give the same boundary.
+                let (to, freq_hz) = refine(model, spec.name, rough, (b - a).abs(), (a, b))
+                    .unwrap_or((rough, c.freq_hz));
                 out.push(Lever {
                     param: spec.name,
                     unit: spec.unit,
                     from: cur,
-                    to: a + c.value * (b - a),
-                    freq_hz: c.freq_hz,
+                    to,
+                    freq_hz,
                 });
             }
         }
     }
     out
+}
+
+/// The crossing near `rough` located on the parameter itself: a bracket of
+/// ±1e-9·`span` around it (inside the searched segment `seg`), then
+/// [`stability::critical`] with its default 1e-10 relative tolerance.
+fn refine(
+    model: &AnyModel,
+    name: &str,
+    rough: f64,
+    span: f64,
+    seg: (f64, f64),
+) -> Option<(f64, f64)> {
+    let (lo_seg, hi_seg) = (seg.0.min(seg.1), seg.0.max(seg.1));
+    let d = 1e-9 * span + 4.0 * f64::EPSILON * rough.abs();
+    let (lo, hi) = ((rough - d).max(lo_seg), (rough + d).min(hi_seg));
+    if lo >= hi {
+        return None;
+    }
+    let opts = CriticalOptions {
+        grid: 2,
+        ..CriticalOptions::default()
+    };
+    let f = |p: f64| crate::commands::critical::growth_at(model, name, p);
+    match stability::critical(f, lo, hi, &opts) {
+        Ok(Some(c)) => Some((c.value, c.freq_hz)),
+        _ => None,
+    }
 }
 
 /// Run the command.
@@ -149,7 +198,9 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         return Ok(());
     }
     let verdict = if an.stable {
-        "STABLE"
+        "STABLE: every mode is damped"
+    } else if an.neutral {
+        "NEUTRAL: no mode grows, but a mode is undamped (σ = 0 within the eigen-solver's round-off, 1e-12·|λ|); linear analysis cannot decide"
     } else {
         "UNSTABLE: it squeals"
     };
@@ -176,7 +227,13 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
             e.freq_hz,
             e.damping_ratio,
             e.dominant_name,
-            if e.growing { "  grows" } else { "" }
+            if e.growing {
+                "  grows"
+            } else if e.neutral {
+                "  neutral"
+            } else {
+                ""
+            }
         );
     }
     let ls = an.least_stable_mode();
@@ -191,7 +248,7 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     } else {
         crate::outln!(
             "{} by changing one parameter (all others as they are):",
-            if an.stable {
+            if !an.eigen.iter().any(|e| e.growing) {
                 "it would start to squeal"
             } else {
                 "what would stop it"
