@@ -5,7 +5,7 @@
 
 use std::io::Write;
 
-/// `println!` for standard output, through [`line`].
+/// `println!` for standard output, through [`line()`].
 #[macro_export]
 macro_rules! outln {
     () => {
