@@ -45,8 +45,8 @@ pub mod stability;
 pub use friction::FrictionLaw;
 pub use integrate::{simulate, Flow, IntegrateError, RunInfo, Sink, Solver, SolverOptions, Stats};
 pub use model::{
-    belt::Belt, disc_pad::DiscPad, hoffmann::Hoffmann, EventKind, Mode, Model, ModelError,
-    Parameters,
+    belt::Belt, disc_pad::DiscPad, hoffmann::Hoffmann, lumped::Lumped, EventKind, Mode, Model,
+    ModelError, Modes, Parameters, System,
 };
 pub use params::{ParamError, ParamSpec};
 pub use stability::{analyse, critical, max_growth_rate, Analysis, StabilityError};

@@ -28,7 +28,7 @@
 
 pub mod eigen;
 
-use crate::model::{Model, ModelError};
+use crate::model::{ModelError, System};
 use crate::params::ParamError;
 use nalgebra::Complex;
 use serde::Serialize;
@@ -111,7 +111,7 @@ pub struct Eigen {
     /// mode's energy (see [`Eigen::participation`]).
     pub dominant: usize,
     /// Name of that coordinate (`Model::state_names`).
-    pub dominant_name: &'static str,
+    pub dominant_name: String,
     /// Energy share of each position coordinate `i < N/2` (sums to 1):
     /// `E_i ∝ m_i·(|u_{n+i}|² + |λ|²·|u_i|²)` with `u` the eigenvector and
     /// `n = N/2`, i.e. twice the kinetic energy of coordinate `i` counted
@@ -188,16 +188,16 @@ impl Inertia for crate::model::hoffmann::Hoffmann {
 /// The steady-sliding state `z*` and the state matrix `A = ∂f/∂z(z*)`,
 /// both checked finite.
 #[allow(clippy::type_complexity)]
-pub fn state_matrix<M: Model<N> + ?Sized, const N: usize>(
+pub fn state_matrix<M: System<N> + ?Sized, const N: usize>(
     model: &M,
 ) -> Result<([f64; N], [[f64; N]; N]), StabilityError> {
-    let z = model.equilibrium()?;
+    let z = model.steady_sliding()?;
     if z.iter().any(|x| !x.is_finite()) {
         return Err(StabilityError::NonFinite {
             what: "equilibrium",
         });
     }
-    let a = model.jacobian(&z);
+    let a = model.state_jacobian(&z);
     if a.iter().flatten().any(|x| !x.is_finite()) {
         return Err(StabilityError::NonFinite { what: "Jacobian" });
     }
@@ -211,7 +211,7 @@ pub fn state_matrix<M: Model<N> + ?Sized, const N: usize>(
 /// [`ModelError::NoSteadySliding`] passes through with its message), the
 /// analytic Jacobian there, Parlett–Reinsch balancing, Francis QR for all N
 /// eigenvalues, inverse iteration for each eigenvector ([`eigen`]).
-pub fn analyse<M: Model<N> + ?Sized, const N: usize>(
+pub fn analyse<M: System<N> + ?Sized, const N: usize>(
     model: &M,
 ) -> Result<Analysis, StabilityError> {
     analyse_impl(model, None)
@@ -219,7 +219,7 @@ pub fn analyse<M: Model<N> + ?Sized, const N: usize>(
 
 /// [`analyse`] with the energy share of each coordinate weighted by its mass
 /// (`masses.len() == N/2`, all > 0; see [`Inertia`]).
-pub fn analyse_with_masses<M: Model<N> + ?Sized, const N: usize>(
+pub fn analyse_with_masses<M: System<N> + ?Sized, const N: usize>(
     model: &M,
     masses: &[f64],
 ) -> Result<Analysis, StabilityError> {
@@ -232,13 +232,13 @@ pub fn analyse_with_masses<M: Model<N> + ?Sized, const N: usize>(
     analyse_impl(model, Some(masses))
 }
 
-fn analyse_impl<M: Model<N> + ?Sized, const N: usize>(
+fn analyse_impl<M: System<N> + ?Sized, const N: usize>(
     model: &M,
     masses: Option<&[f64]>,
 ) -> Result<Analysis, StabilityError> {
     let (z, a) = state_matrix(model)?;
     let (ev, bal, d) = eigen::eigenvalues_balanced(&a).ok_or(StabilityError::NoConvergence)?;
-    let names = model.state_names();
+    let names = model.names();
     let n = N / 2;
     let mut modes: Vec<Eigen> = ev
         .iter()
@@ -272,7 +272,7 @@ fn analyse_impl<M: Model<N> + ?Sized, const N: usize>(
                 damping_ratio: if mag > 0.0 { -lambda.re / mag } else { 0.0 },
                 growing: is_growing(lambda.re, lambda.im),
                 dominant,
-                dominant_name: names.get(dominant).copied().unwrap_or(""),
+                dominant_name: names.get(dominant).cloned().unwrap_or_default(),
                 participation: e,
                 vector: u.to_vec(),
             }
@@ -293,7 +293,7 @@ fn analyse_impl<M: Model<N> + ?Sized, const N: usize>(
 /// steady-sliding state and the frequency `|Im λ|/2π` (Hz) of that mode
 /// (0 for a real eigenvalue). Eigenvalues only, on stack arrays: no heap
 /// allocation. Same equilibrium, Jacobian and eigen-solver as [`analyse`].
-pub fn max_growth_rate<M: Model<N> + ?Sized, const N: usize>(
+pub fn max_growth_rate<M: System<N> + ?Sized, const N: usize>(
     model: &M,
 ) -> Result<(f64, f64), StabilityError> {
     let (_, a) = state_matrix(model)?;
