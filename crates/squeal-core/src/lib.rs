@@ -37,6 +37,7 @@
 pub mod friction;
 pub mod initial;
 pub mod integrate;
+pub mod matrix_market;
 pub mod model;
 pub mod params;
 pub mod sink;

@@ -141,10 +141,14 @@ impl Contact {
             }
         )
     }
-    /// Sliding velocity `V + tangent·q̇`.
+    /// Sliding velocity `V + tangent·q̇` (summed from V, term by term).
     #[inline]
     pub fn sliding_velocity(&self, u: &[f64]) -> f64 {
-        self.v + self.tangent.dot(u)
+        let mut s = self.v;
+        for (i, c) in self.tangent.idx.iter().zip(&self.tangent.coef) {
+            s += c * u[*i];
+        }
+        s
     }
     /// Friction force in a slip mode: `s·μ(s·v)·F_n` (the smooth continuation
     /// `s·v`, not `|v|`, so that a step overshooting the guard sees no kink).
