@@ -142,10 +142,11 @@ fn spectrum_of(name: &str, x: &[f64], fs: f64, set: &SpectrumSettings) -> Option
 pub fn analyse(run: &Run, ch: &Channels, set: &SpectrumSettings) -> Analysis {
     let fs = run.sample_rate;
     let tangential = run
-        .column(ch.tangential)
-        .and_then(|x| spectrum_of(ch.tangential, x, fs, set));
+        .column(&ch.tangential)
+        .and_then(|x| spectrum_of(&ch.tangential, x, fs, set));
     let normal = ch
         .normal
+        .as_deref()
         .and_then(|n| run.column(n).and_then(|x| spectrum_of(n, x, fs, set)));
     let t_end = run
         .column("t")
@@ -342,15 +343,18 @@ pub fn draw(
     // The thesis's pictures: each velocity against time on its own axis (their
     // sizes differ by orders of magnitude), then the spectrum of each.
     let tan_title = format!("{title}: tangential velocity {}", ch.tangential);
-    let nor_title = format!("{title}: normal velocity {}", ch.normal.unwrap_or(""));
+    let nor_title = format!(
+        "{title}: normal velocity {}",
+        ch.normal.as_deref().unwrap_or("")
+    );
     let mut panels = Vec::new();
-    if let Some(x) = run.column(ch.tangential) {
+    if let Some(x) = run.column(&ch.tangential) {
         panels.push(
             // One series per panel, named in its title: no legend to cover the data.
             Panel::new(&tan_title, "time (s)", "velocity (m/s)").with_series(Series::new("", t, x)),
         );
     }
-    if let Some(x) = ch.normal.and_then(|n| run.column(n)) {
+    if let Some(x) = ch.normal.as_deref().and_then(|n| run.column(n)) {
         panels.push(
             Panel::new(&nor_title, "time (s)", "velocity (m/s)").with_series(Series::new("", t, x)),
         );
@@ -405,7 +409,7 @@ pub fn draw(
     let size = (1200, 300 * panels.len() as u32);
     squeal_plot::line_panels(dir.join("triplet"), &formats, size, &panels).map_err(plot_err)?;
 
-    if let Some(x) = run.column(ch.tangential) {
+    if let Some(x) = run.column(&ch.tangential) {
         let seg = 2048.min(x.len().max(2));
         if let Ok(sg) = spectrogram(
             x,
@@ -437,7 +441,7 @@ pub fn draw(
             .map_err(plot_err)?;
         }
     }
-    if let (Some(x), Some(v)) = (run.column(ch.phase.0), run.column(ch.phase.1)) {
+    if let (Some(x), Some(v)) = (run.column(&ch.phase.0), run.column(&ch.phase.1)) {
         // The last fifth of the run: the settled motion (a stick line, if any, is flat at v = V).
         let from = x.len() - x.len() / 5;
         let (x, v) = (&x[from..], &v[from..]);

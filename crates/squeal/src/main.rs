@@ -6,6 +6,7 @@
 
 mod analysis;
 mod commands;
+mod lumped_file;
 mod model;
 mod output;
 mod run;

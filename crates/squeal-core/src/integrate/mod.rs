@@ -16,7 +16,7 @@
 pub mod roots;
 mod tableau;
 
-use crate::model::{EventKind, Guard, Guards, Mode, Modes, System};
+use crate::model::{EventKind, Guard, GuardKind, Guards, Mode, Modes, System};
 use tableau::{A, B, C, D, E3, E5};
 
 /// Tuning knobs of the integrator. Times in seconds.
@@ -417,9 +417,13 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 };
                 // Leaving at once needs a rate clearly above round-off: at a
                 // smooth stick→slip transition (μ(0+) = μ_s) the rate is zero
-                // and the sign of round-off must not decide. A guard clearly
-                // positive (beyond round-off of its terms) fires whatever its rate.
-                if (val >= 0.0 && rate > 1e-9 * scale) || val > 1e-9 * vscale {
+                // and the sign of round-off must not decide. A stick bound
+                // clearly exceeded (beyond round-off of its terms: another
+                // contact's transition changed this one's multiplier) fires
+                // whatever its rate.
+                let stick_break =
+                    matches!(g.kind, GuardKind::StickBreakPos | GuardKind::StickBreakNeg);
+                if (val >= 0.0 && rate > 1e-9 * scale) || (stick_break && val > 1e-9 * vscale) {
                     fired = Some(*g);
                     break;
                 }

@@ -38,6 +38,7 @@ use super::{
     EventKind, Guard, GuardKind, Guards, Mode, ModelError, Modes, Observables, System, MAX_CONTACTS,
 };
 use crate::friction::FrictionLaw;
+use crate::params::ParamError;
 use nalgebra::DMatrix;
 
 /// A bad model description: one line naming the element and key.
@@ -581,7 +582,7 @@ impl Lumped {
             }
             c.friction
                 .validate()
-                .map_err(|e| SpecError(format!("{what}: {e}")))?;
+                .map_err(|e| SpecError(format!("{what}: {}", prefixed(&c.name, e))))?;
             let slope = combo(&what, "slope", &c.slope)?;
             if c.alpha != 0.0 && matches!(normal, Normal::Prescribed(_)) {
                 return bad(format!(
@@ -1256,60 +1257,52 @@ impl Lumped {
     }
 
     /// Set a parameter by key, checking its range; the model is re-checked
-    /// (stick constraints, mass matrix) afterwards.
-    pub fn set(&mut self, key: &str, value: f64) -> Result<(), SpecError> {
-        let (el, k) = key.split_once('.').ok_or_else(|| {
-            SpecError(format!(
-                "unknown key '{key}' (lumped models take <element>.<key> or mass.<dof>)"
-            ))
-        })?;
-        let nonneg = |v: f64| -> Result<f64, SpecError> {
+    /// (stick constraints, mass matrix) afterwards. Keys are
+    /// `<element>.<key>` and `mass.<dof>`.
+    pub fn set(&mut self, key: &str, value: f64) -> Result<(), ParamError> {
+        let invalid = |why: &str| ParamError::Invalid {
+            key: key.into(),
+            value,
+            why: why.into(),
+        };
+        let unknown = || ParamError::Unknown { key: key.into() };
+        let (el, k) = key.split_once('.').ok_or_else(unknown)?;
+        let nonneg = |v: f64| {
             if v.is_finite() && v >= 0.0 {
                 Ok(v)
             } else {
-                bad(format!("{key} = {v}: must be a finite number ≥ 0"))
+                Err(invalid("must be a finite number ≥ 0"))
             }
         };
-        let finite = |v: f64| -> Result<f64, SpecError> {
+        let finite = |v: f64| {
             if v.is_finite() {
                 Ok(v)
             } else {
-                bad(format!("{key} = {v}: must be a finite number"))
+                Err(invalid("must be a finite number"))
             }
         };
+        let mut refresh = false;
         if el == "mass" {
-            let i = self.dofs.iter().position(|d| d == k).ok_or_else(|| {
-                SpecError(format!(
-                    "{key}: unknown dof '{k}' (dofs: {})",
-                    self.dofs.join(", ")
-                ))
-            })?;
+            let i = self.dofs.iter().position(|d| d == k).ok_or_else(unknown)?;
             if !(value.is_finite() && value > 0.0) {
-                return bad(format!(
-                    "{key} = {value}: a mass must be a finite number > 0 (kg)"
-                ));
+                return Err(invalid("a mass must be a finite number > 0 (kg)"));
             }
             self.masses[i] = value;
-            return self.refresh();
-        }
-        if let Some(s) = self.springs.iter_mut().find(|s| s.name == el) {
+            refresh = true;
+        } else if let Some(s) = self.springs.iter_mut().find(|s| s.name == el) {
             match k {
                 "k" => s.k = nonneg(value)?,
                 "c" => s.c = nonneg(value)?,
-                _ => return bad(format!("unknown key '{key}': a spring has k, c")),
+                _ => return Err(unknown()),
             }
-            return Ok(());
-        }
-        if let Some(f) = self.forces.iter_mut().find(|f| f.name == el) {
+        } else if let Some(f) = self.forces.iter_mut().find(|f| f.name == el) {
             match k {
                 "value" => f.value = finite(value)?,
                 "ramp" => f.ramp = nonneg(value)?,
-                _ => return bad(format!("unknown key '{key}': a force has value, ramp")),
+                _ => return Err(unknown()),
             }
             self.has_ramp = self.forces.iter().any(|f| f.ramp > 0.0);
-            return Ok(());
-        }
-        if let Some(c) = self.contacts.iter_mut().find(|c| c.name == el) {
+        } else if let Some(c) = self.contacts.iter_mut().find(|c| c.name == el) {
             match (k, &mut c.normal) {
                 ("k", Normal::Elastic { k, .. }) => *k = nonneg(value)?,
                 ("c", Normal::Elastic { c, .. }) => *c = nonneg(value)?,
@@ -1317,39 +1310,107 @@ impl Lumped {
                 ("V", _) => c.v = finite(value)?,
                 ("alpha", _) => {
                     c.alpha = finite(value)?;
-                    return self.refresh();
+                    refresh = true;
                 }
                 (fk, _) if c.friction.get(fk).is_some() => {
-                    c.friction
-                        .set(fk, value)
-                        .map_err(|e| SpecError(format!("{el}.{e}")))?;
+                    c.friction.set(fk, value).map_err(|e| prefixed(el, e))?;
                 }
-                _ => {
-                    let law: Vec<&str> = c.friction.params().iter().map(|p| p.name).collect();
-                    let normal = match c.normal {
-                        Normal::Elastic { .. } => "k, c",
-                        Normal::Prescribed(_) => "normal_force",
-                    };
-                    return bad(format!(
-                        "unknown key '{key}': contact '{el}' has {normal}, V, alpha and its {} law's {}",
-                        c.friction.name(),
-                        law.join(", ")
-                    ));
-                }
+                _ => return Err(unknown()),
             }
-            return Ok(());
+        } else {
+            return Err(unknown());
         }
-        bad(format!("unknown key '{key}': no element named '{el}'"))
+        if refresh {
+            self.refresh().map_err(|e| ParamError::Relation {
+                key: key.into(),
+                value,
+                why: e.0,
+            })?;
+        }
+        Ok(())
     }
 
     /// Check relations between parameters (each contact's friction law).
-    pub fn validate(&self) -> Result<(), SpecError> {
+    pub fn validate(&self) -> Result<(), ParamError> {
         for c in &self.contacts {
-            c.friction
-                .validate()
-                .map_err(|e| SpecError(format!("contact '{}': {}.{e}", c.name, c.name)))?;
+            c.friction.validate().map_err(|e| prefixed(&c.name, e))?;
         }
         Ok(())
+    }
+
+    /// Unit and meaning of a parameter key (for tables and axis labels).
+    pub fn describe(&self, key: &str) -> Option<(&'static str, String)> {
+        let (el, k) = key.split_once('.')?;
+        if el == "mass" {
+            return Some(("kg", format!("mass of dof {k}")));
+        }
+        if self.springs.iter().any(|s| s.name == el) {
+            return match k {
+                "k" => Some(("N/m", format!("stiffness of spring {el}"))),
+                "c" => Some(("kg/s", format!("damping of spring {el}"))),
+                _ => None,
+            };
+        }
+        if self.forces.iter().any(|f| f.name == el) {
+            return match k {
+                "value" => Some(("N", format!("value of force {el}"))),
+                "ramp" => Some(("s", format!("ramp time of force {el}"))),
+                _ => None,
+            };
+        }
+        let c = self.contacts.iter().find(|c| c.name == el)?;
+        match k {
+            "k" => Some(("N/m", format!("contact stiffness of {el}"))),
+            "c" => Some(("kg/s", format!("contact damping of {el}"))),
+            "normal_force" => Some(("N", format!("prescribed normal load of {el}"))),
+            "V" => Some(("m/s", format!("surface speed at {el}"))),
+            "alpha" => Some(("1/m", format!("follower-force coefficient of {el}"))),
+            _ => c
+                .friction
+                .params()
+                .iter()
+                .find(|p| p.name == k)
+                .map(|p| (p.unit, format!("{} ({el})", p.doc))),
+        }
+    }
+
+    /// The kind of values a key takes (sign), for lever and map ranges.
+    pub fn kind_of(&self, key: &str) -> crate::params::ParamKind {
+        use crate::params::ParamKind;
+        let (el, k) = key.split_once('.').unwrap_or(("", key));
+        if el == "mass" {
+            return ParamKind::Positive;
+        }
+        match k {
+            "value" | "V" | "alpha" => ParamKind::Any,
+            "k" | "c" | "ramp" | "normal_force" => ParamKind::NonNegative,
+            _ => self
+                .contacts
+                .iter()
+                .find(|c| c.name == el)
+                .and_then(|c| c.friction.params().iter().find(|p| p.name == k))
+                .map_or(ParamKind::Any, |p| p.kind),
+        }
+    }
+}
+
+/// A friction-law error with the key as users type it for a lumped model (`pad1.mu_k`).
+fn prefixed(el: &str, e: ParamError) -> ParamError {
+    match e {
+        ParamError::Unknown { key } => ParamError::Unknown {
+            key: format!("{el}.{key}"),
+        },
+        ParamError::Invalid { key, value, why } => ParamError::Invalid {
+            key: format!("{el}.{key}"),
+            value,
+            why,
+        },
+        ParamError::Relation { key, value, why } => ParamError::Relation {
+            key: format!("{el}.{key}"),
+            value,
+            why: why.replace("mu_k", &format!("{el}.mu_k")),
+        },
+        other => other,
     }
 }
 
@@ -1687,4 +1748,157 @@ impl Lumped {
         }
         a
     }
+}
+
+/// Most dofs a lumped model may have to be simulated: the integrator works on
+/// fixed-size state arrays, so each size is compiled in (`2·MAX_SIM_DOFS`
+/// states at most). Stability analysis works for any size.
+pub const MAX_SIM_DOFS: usize = 16;
+
+/// A lumped model seen at one state count `N = 2·dofs`, so that generic code
+/// (`simulate`, `analyse`) infers `N` from the type. Delegates everything.
+#[derive(Debug, Clone, Copy)]
+pub struct Fixed<'a, const N: usize>(pub &'a Lumped);
+
+impl<const N: usize> System<N> for Fixed<'_, N> {
+    fn system_name(&self) -> &str {
+        "lumped"
+    }
+    fn names(&self) -> Vec<String> {
+        self.0.states.clone()
+    }
+    fn contacts(&self) -> usize {
+        self.0.contacts.len()
+    }
+    fn contact_name(&self, i: usize) -> &str {
+        &self.0.contacts[i].name
+    }
+    #[inline(always)]
+    fn field(&self, t: f64, modes: &Modes, z: &[f64; N], dz: &mut [f64; N]) {
+        <Lumped as System<N>>::field(self.0, t, modes, z, dz)
+    }
+    fn mode_guards(&self, modes: &Modes, out: &mut Guards<N>) {
+        <Lumped as System<N>>::mode_guards(self.0, modes, out)
+    }
+    #[inline]
+    fn guard_value(&self, t: f64, modes: &Modes, g: &Guard<N>, z: &[f64; N]) -> f64 {
+        <Lumped as System<N>>::guard_value(self.0, t, modes, g, z)
+    }
+    fn guard_gradient(&self, t: f64, modes: &Modes, g: &Guard<N>, z: &[f64; N]) -> [f64; N] {
+        <Lumped as System<N>>::guard_gradient(self.0, t, modes, g, z)
+    }
+    fn guard_slope_bound(
+        &self,
+        t0: f64,
+        h: f64,
+        modes: &Modes,
+        g: &Guard<N>,
+        lo: &[f64; N],
+        hi: &[f64; N],
+        rate: &[f64; N],
+    ) -> f64 {
+        <Lumped as System<N>>::guard_slope_bound(self.0, t0, h, modes, g, lo, hi, rate)
+    }
+    fn switch(
+        &self,
+        t: f64,
+        modes: &Modes,
+        g: &Guard<N>,
+        z: &mut [f64; N],
+    ) -> (Modes, Option<EventKind>) {
+        <Lumped as System<N>>::switch(self.0, t, modes, g, z)
+    }
+    fn start_modes(&self, t: f64, z: &[f64; N]) -> Modes {
+        <Lumped as System<N>>::start_modes(self.0, t, z)
+    }
+    fn observe_contact(&self, t: f64, modes: &Modes, z: &[f64; N], i: usize) -> Observables {
+        self.0.observe_dyn(t, modes, z, i)
+    }
+    fn breakpoint_after(&self, t: f64) -> Option<f64> {
+        <Lumped as System<N>>::breakpoint_after(self.0, t)
+    }
+    fn steady_sliding(&self) -> Result<[f64; N], ModelError> {
+        <Lumped as System<N>>::steady_sliding(self.0)
+    }
+    fn state_jacobian(&self, z: &[f64; N]) -> [[f64; N]; N] {
+        <Lumped as System<N>>::state_jacobian(self.0, z)
+    }
+}
+
+/// Run `$body` with `$m` bound to `&Fixed<N>` for the lumped model `$l`
+/// (`N = 2·dofs`, dofs ≤ [`MAX_SIM_DOFS`]), or evaluate `$fallback` for a
+/// larger model.
+#[macro_export]
+macro_rules! with_lumped_size {
+    ($l:expr, $m:ident => $body:expr, else => $fallback:expr) => {{
+        use $crate::model::lumped::Fixed;
+        let l: &$crate::Lumped = $l;
+        match l.dof_count() {
+            1 => {
+                let $m = &Fixed::<2>(l);
+                $body
+            }
+            2 => {
+                let $m = &Fixed::<4>(l);
+                $body
+            }
+            3 => {
+                let $m = &Fixed::<6>(l);
+                $body
+            }
+            4 => {
+                let $m = &Fixed::<8>(l);
+                $body
+            }
+            5 => {
+                let $m = &Fixed::<10>(l);
+                $body
+            }
+            6 => {
+                let $m = &Fixed::<12>(l);
+                $body
+            }
+            7 => {
+                let $m = &Fixed::<14>(l);
+                $body
+            }
+            8 => {
+                let $m = &Fixed::<16>(l);
+                $body
+            }
+            9 => {
+                let $m = &Fixed::<18>(l);
+                $body
+            }
+            10 => {
+                let $m = &Fixed::<20>(l);
+                $body
+            }
+            11 => {
+                let $m = &Fixed::<22>(l);
+                $body
+            }
+            12 => {
+                let $m = &Fixed::<24>(l);
+                $body
+            }
+            13 => {
+                let $m = &Fixed::<26>(l);
+                $body
+            }
+            14 => {
+                let $m = &Fixed::<28>(l);
+                $body
+            }
+            15 => {
+                let $m = &Fixed::<30>(l);
+                $body
+            }
+            16 => {
+                let $m = &Fixed::<32>(l);
+                $body
+            }
+            _ => $fallback,
+        }
+    }};
 }

@@ -35,7 +35,7 @@ use nalgebra::Complex;
 
 /// Most sweeps of [`balance`] (it converges in a handful; this only bounds
 /// the loop on pathological input).
-const MAX_BALANCE_SWEEPS: usize = 200;
+pub const MAX_BALANCE_SWEEPS: usize = 200;
 
 /// QR iterations allowed per eigenvalue in [`hqr`] before it gives up.
 pub const MAX_QR_ITERATIONS: usize = 60;

@@ -27,6 +27,7 @@
 //! the reasons it is hand-written).
 
 pub mod eigen;
+pub mod lumped;
 
 use crate::model::{ModelError, System};
 use crate::params::ParamError;

@@ -49,10 +49,10 @@ pub fn parse_interval(spec: &str, flag: &str) -> Result<(String, f64, f64), Inpu
 
 /// Least stable growth rate and its frequency with `name` set to `value`.
 pub fn growth_at(model: &AnyModel, name: &str, value: f64) -> Result<(f64, f64), StabilityError> {
-    let mut m = *model;
+    let mut m = model.clone();
     m.set(name, value)?;
     m.validate()?;
-    crate::with_model!(&m, mm => stability::max_growth_rate(mm))
+    m.max_growth_rate()
 }
 
 /// Locate the crossing of `name` in `[lo, hi]`.

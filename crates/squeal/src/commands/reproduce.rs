@@ -46,7 +46,7 @@ struct Linear {
     growing: bool,
     neutral: bool,
     /// (σ, ω, dominant) of every eigenvalue with ω ≥ 0, sorted by σ.
-    modes: Vec<(f64, f64, &'static str)>,
+    modes: Vec<(f64, f64, String)>,
 }
 
 /// Everything measured on one set.
@@ -138,7 +138,7 @@ fn linear_of(model: &AnyModel) -> Result<Linear, String> {
             .eigen
             .iter()
             .filter(|e| e.im >= 0.0)
-            .map(|e| (e.re, e.im, e.dominant_name))
+            .map(|e| (e.re, e.im, e.dominant_name.clone()))
             .collect(),
     })
 }
@@ -264,7 +264,7 @@ fn sweeps(base: &AnyModel) -> Sweeps {
     for &n in &[100.0, 500.0, 2000.0, 5000.0] {
         for i in 1..=200 {
             let v = uc * (1.0 + 2.0 * i as f64 / 200.0);
-            let mut m = *base;
+            let mut m = base.clone();
             let ok = m
                 .set("V", v)
                 .and(m.set("N", n))
@@ -273,7 +273,7 @@ fn sweeps(base: &AnyModel) -> Sweeps {
             if ok.is_err() {
                 continue;
             }
-            if let Ok((s, _)) = crate::with_model!(&m, mm => stability::max_growth_rate(mm)) {
+            if let Ok((s, _)) = m.max_growth_rate() {
                 worst.0 += 1;
                 if s > worst.1 {
                     worst = (worst.0, s, v, n);
@@ -281,20 +281,18 @@ fn sweeps(base: &AnyModel) -> Sweeps {
             }
         }
     }
-    let mut m = *base;
+    let mut m = base.clone();
     let _ = m.set("V", 0.9 * uc);
-    let below = crate::with_model!(&m, mm => stability::max_growth_rate(mm))
-        .map(|r| r.0)
-        .unwrap_or(f64::NAN);
+    let below = m.max_growth_rate().map(|r| r.0).unwrap_or(f64::NAN);
     let crit = |n: f64| {
-        let mut m = *base;
+        let mut m = base.clone();
         m.set("N", n).ok()?;
         m.set("V", 1.0).ok()?;
         let f = |c: f64| {
-            let mut mm = m;
+            let mut mm = m.clone();
             mm.set("c_dx", c)?;
             mm.set("c_px", c)?;
-            crate::with_model!(&mm, x => stability::max_growth_rate(x))
+            mm.max_growth_rate()
         };
         stability::critical(f, 0.0, 100.0, &stability::CriticalOptions::default())
             .ok()
@@ -302,7 +300,7 @@ fn sweeps(base: &AnyModel) -> Sweeps {
             .map(|c| c.value)
     };
     let shift = |alpha: f64| -> f64 {
-        let mut m = *base;
+        let mut m = base.clone();
         let _ = m.set("alpha", alpha);
         let (a0, a1) = (eigen_analyse(base), eigen_analyse(&m));
         match (a0, a1) {
@@ -865,13 +863,11 @@ fn draw_map(rs: &[SetResult], dir: &Path) -> Result<(), RunError> {
         .into_par_iter()
         .map(|k| {
             let (i, j) = (k % xs.len(), k / xs.len());
-            let mut m = base;
+            let mut m = base.clone();
             if m.set("V", xs[i]).and(m.set("N", ys[j])).is_err() {
                 return f64::NAN;
             }
-            crate::with_model!(&m, mm => stability::max_growth_rate(mm))
-                .map(|r| r.0)
-                .unwrap_or(f64::NAN)
+            m.max_growth_rate().map(|r| r.0).unwrap_or(f64::NAN)
         })
         .collect();
     // Group the sets by position so that coincident sets share one label.

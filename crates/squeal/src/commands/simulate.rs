@@ -127,7 +127,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         analysis::draw(&run, &an, &channels, &sc.name, stage.dir())?;
     }
     if a.wav {
-        if let Some(x) = run.column(channels.tangential) {
+        if let Some(x) = run.column(&channels.tangential) {
             let clip = analysis::write_wav(x, run.sample_rate, &stage.path("squeal.wav"), false)?;
             if clip.looped {
                 eprintln!(

@@ -34,8 +34,7 @@ pub fn stability_error(e: StabilityError) -> RunError {
 
 /// Full analysis of any model, with mass-weighted mode attribution.
 pub fn analyse(model: &AnyModel) -> Result<Analysis, StabilityError> {
-    use squeal_core::stability::Inertia;
-    crate::with_model!(model, m => stability::analyse_with_masses(m, &m.position_masses()))
+    model.analyse()
 }
 
 /// The JSON document of an analysis.
@@ -70,7 +69,7 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Lever {
     /// Parameter name.
-    pub param: &'static str,
+    pub param: String,
     /// Its unit.
     pub unit: &'static str,
     /// Its current value.
@@ -87,16 +86,15 @@ pub struct Lever {
 /// (±1e5 for a signed parameter) by [`stability::critical`].
 pub fn levers(model: &AnyModel) -> Vec<Lever> {
     use squeal_core::params::ParamKind;
-    let specs = model.param_specs().iter().chain(model.friction().params());
     let mut out = Vec::new();
-    for spec in specs {
-        if spec.name == "t_ramp" {
+    for (name, unit, _, kind) in model.keys() {
+        if name == "t_ramp" || name.ends_with(".ramp") {
             continue; // a start-up setting, no part of steady sliding
         }
-        let Some(cur) = model.get(spec.name) else {
+        let Some(cur) = model.get(&name) else {
             continue;
         };
-        let (lo, hi) = match spec.kind {
+        let (lo, hi) = match kind {
             ParamKind::Positive => (cur / 1000.0, cur * 1000.0),
             ParamKind::NonNegative => (0.0, if cur > 0.0 { cur * 1000.0 } else { 1000.0 }),
             ParamKind::Any => (
@@ -109,16 +107,15 @@ pub fn levers(model: &AnyModel) -> Vec<Lever> {
                 continue;
             }
             // Search outwards from the current value: s ∈ [0, 1] maps to a + s (b − a).
-            let f =
-                |s: f64| crate::commands::critical::growth_at(model, spec.name, a + s * (b - a));
+            let f = |s: f64| crate::commands::critical::growth_at(model, &name, a + s * (b - a));
             let opts = CriticalOptions {
                 grid: 48,
                 ..CriticalOptions::default()
             };
             if let Ok(Some(c)) = stability::critical(f, 0.0, 1.0, &opts) {
                 out.push(Lever {
-                    param: spec.name,
-                    unit: spec.unit,
+                    param: name.clone(),
+                    unit,
                     from: cur,
                     to: a + c.value * (b - a),
                     freq_hz: c.freq_hz,
@@ -133,7 +130,10 @@ pub fn levers(model: &AnyModel) -> Vec<Lever> {
 pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
     let an = analyse(&sc.model).map_err(stability_error)?;
-    let levers = levers(&sc.model);
+    // Levers need hundreds of analyses: only for models of the fixed-size path.
+    let large = matches!(&sc.model, AnyModel::Lumped(l)
+        if l.dof_count() > squeal_core::model::lumped::MAX_SIM_DOFS);
+    let levers = if large { Vec::new() } else { levers(&sc.model) };
     if a.json {
         let mut doc = analysis_json(&sc.model, &an);
         doc["scenario"] = sc.to_json();
@@ -179,7 +179,12 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         "least stable mode: {:.2} Hz, dominated by {}, σ = {:+.6e} 1/s",
         ls.freq_hz, ls.dominant_name, ls.re
     );
-    if levers.is_empty() {
+    if large {
+        println!(
+            "(levers are searched only for models of up to {} dofs)",
+            squeal_core::model::lumped::MAX_SIM_DOFS
+        );
+    } else if levers.is_empty() {
         println!("no single parameter change within ×1000 either way changes the verdict");
     } else {
         println!(
