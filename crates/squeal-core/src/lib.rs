@@ -34,6 +34,7 @@
 //! assert_eq!(run.stats.event_count(EventKind::Reverse), 0); // too early for stick-slip
 //! ```
 
+pub mod cycle;
 pub mod friction;
 pub mod initial;
 pub mod integrate;
