@@ -45,6 +45,8 @@ enum Command {
     Map(commands::map::MapArgs),
     /// Locate the parameter value where steady sliding changes stability.
     Critical(commands::critical::CriticalArgs),
+    /// The limit cycle a scenario settles on: period, Floquet multipliers, amplitudes, events.
+    Cycle(commands::cycle::CycleArgs),
     /// Re-do the thesis: 40 sets, Appendix A, the seven conclusions checked, a report.
     Reproduce(commands::reproduce::ReproduceArgs),
     /// Redraw the pictures of a saved run without re-simulating.
@@ -69,6 +71,7 @@ fn main() -> ExitCode {
         Command::Map(a) => commands::map::run(a),
         Command::Critical(a) => commands::critical::run(a),
         Command::Listen(a) => commands::listen::run(a),
+        Command::Cycle(a) => commands::cycle::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -65,6 +65,9 @@ pub struct CycleOptions {
     pub settle_steps: u64,
     /// Most simulated time spent settling (s).
     pub settle_time: f64,
+    /// Relative tolerance of the settling run (at least the solver's own):
+    /// settling only needs to come close, Newton's method does the rest.
+    pub settle_rtol: f64,
     /// Two returns to the section count as the same point when they differ
     /// by less than this, relative to the orbit's amplitude.
     pub settle_tol: f64,
@@ -88,7 +91,8 @@ impl Default for CycleOptions {
             section: None,
             settle_steps: 20_000_000,
             settle_time: 1000.0,
-            settle_tol: 1e-4,
+            settle_rtol: 1e-8,
+            settle_tol: 1e-2,
             max_returns: 8,
             newton_tol: 1e-8,
             newton_iterations: 30,
@@ -181,8 +185,8 @@ pub struct Orbit<const N: usize> {
     pub event: Vec<Option<(EventKind, usize)>>,
 }
 
-/// Largest `h‖J‖` (scaled, ∞-norm) of one Magnus step.
-const MAGNUS_H: f64 = 0.05;
+/// Largest `h·‖ΔJ‖` (scaled, ∞-norm) of one Magnus step.
+const MAGNUS_VARIATION: f64 = 1e-4;
 
 /// What integrating one period with the variational equations gives.
 struct Period<const N: usize> {
@@ -313,6 +317,7 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
     period: f64,
     s: &[f64; N],
     opts: &CycleOptions,
+    variational: bool,
     mut orbit: Option<&mut Orbit<N>>,
 ) -> Result<Period<N>, CycleError> {
     let mut solver = Solver::new(sys, 0.0, *z0, period, opts.solver)?;
@@ -331,17 +336,33 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
         o.event.push(None);
     }
     while let Some(seg) = solver.step()? {
-        // Magnus steps short enough that h‖J‖ ≤ MAGNUS_H (the method's
-        // error goes as h⁵ times the variation of J).
-        let len = seg.t1 - seg.t0;
+        // Magnus steps short enough that the variation of J over one,
+        // h·‖J(t₁) − J(t₀)‖ (scaled), stays below MAGNUS_VARIATION: the
+        // method is exact for constant J, and its error grows with J's change.
+        let len = if variational { seg.t1 - seg.t0 } else { 0.0 };
         let mut subs = subs;
         if len > 0.0 {
-            let tm = 0.5 * (seg.t0 + seg.t1);
-            scaled_jacobian(sys, tm, &seg.modes, &solver.dense_at(tm), s, &mut j1);
-            let rho = (0..N)
-                .map(|i| (0..N).map(|j| j1[(i, j)].abs()).sum::<f64>())
+            scaled_jacobian(
+                sys,
+                seg.t0,
+                &seg.modes,
+                &solver.dense_at(seg.t0),
+                s,
+                &mut j1,
+            );
+            scaled_jacobian(
+                sys,
+                seg.t1,
+                &seg.modes,
+                &solver.dense_at(seg.t1),
+                s,
+                &mut j2,
+            );
+            let var = (0..N)
+                .map(|i| (0..N).map(|j| (j2[(i, j)] - j1[(i, j)]).abs()).sum::<f64>())
                 .fold(0.0, f64::max);
-            let need = (len * rho / MAGNUS_H).ceil();
+            // J's change over a substep is var/subs, times its length len/subs.
+            let need = (len * var / MAGNUS_VARIATION).sqrt().ceil();
             if need.is_finite() && need > subs as f64 {
                 subs = (need as usize).min(4096);
             }
@@ -380,8 +401,10 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
             let z_m = solver.dense_at(seg.t1);
             let z_p = *solver.state();
             let modes_p = solver.modes();
-            let sm = saltation(sys, seg.t1, &seg.modes, &z_m, &modes_p, &z_p, s);
-            phi = sm * phi;
+            if variational {
+                let sm = saltation(sys, seg.t1, &seg.modes, &z_m, &modes_p, &z_p, s);
+                phi = sm * phi;
+            }
             if let Some(ev) = seg.event {
                 events[ev.index()] += 1;
             }
@@ -442,6 +465,7 @@ pub fn settle<S: System<N> + ?Sized, const N: usize>(
     let t_end = t0 + opts.settle_time;
     let mut sopts = opts.solver;
     sopts.max_steps = opts.settle_steps;
+    sopts.rtol = sopts.rtol.max(opts.settle_rtol);
     let mut solver = Solver::new(sys, t0, z0, t_end, sopts)?;
     let candidates: Vec<Section> = match opts.section {
         Some(s) => vec![s],
@@ -481,23 +505,14 @@ pub fn settle<S: System<N> + ?Sized, const N: usize>(
             if !(g0 < 0.0 && g1 >= 0.0) {
                 continue;
             }
-            // Bisection on the dense output for the crossing.
-            let (mut a, mut b) = (seg.t0, seg.t1);
-            for _ in 0..200 {
-                let m = 0.5 * (a + b);
-                if m <= a || m >= b {
-                    break;
-                }
-                if solver.dense_at(m)[sec.index] - sec.level < 0.0 {
-                    a = m;
-                } else {
-                    b = m;
-                }
-            }
-            let mut z = solver.dense_at(b);
-            z[sec.index] = sec.level;
+            // The crossing by linear interpolation (enough to compare returns
+            // to settle_tol); refined by bisection on the dense output once a
+            // period is found.
+            let th = g0 / (g0 - g1);
+            let tc = seg.t0 + th * (seg.t1 - seg.t0);
+            let z = solver.dense_at(tc);
             let r = Return {
-                t: b,
+                t: tc,
                 z,
                 lo: lo[c],
                 hi: hi[c],
@@ -509,8 +524,21 @@ pub fn settle<S: System<N> + ?Sized, const N: usize>(
             if list.len() > keep {
                 list.remove(0);
             }
-            if let Some(found) = periodic(list, opts, n) {
-                let z_start = list[list.len() - 1].z;
+            if let Some(found) = periodic(list, opts, n, sec.index) {
+                let (mut a, mut b) = (seg.t0, seg.t1);
+                for _ in 0..200 {
+                    let m = 0.5 * (a + b);
+                    if m <= a || m >= b {
+                        break;
+                    }
+                    if solver.dense_at(m)[sec.index] - sec.level < 0.0 {
+                        a = m;
+                    } else {
+                        b = m;
+                    }
+                }
+                let mut z_start = solver.dense_at(b);
+                z_start[sec.index] = sec.level;
                 return Ok((*sec, z_start, found, solver.t() - t0));
             }
         }
@@ -527,7 +555,12 @@ fn not_settled_cause<const N: usize>(returns: &[Vec<Return<N>>]) -> String {
 }
 
 /// If the last return repeats the one `m` returns earlier (m = 1, 2, …), the period.
-fn periodic<const N: usize>(list: &[Return<N>], opts: &CycleOptions, n: usize) -> Option<f64> {
+fn periodic<const N: usize>(
+    list: &[Return<N>],
+    opts: &CycleOptions,
+    n: usize,
+    index: usize,
+) -> Option<f64> {
     let last = list.len() - 1;
     for m in 1..=opts.max_returns {
         // Need the amplitude over the m returns before it too.
@@ -541,9 +574,12 @@ fn periodic<const N: usize>(list: &[Return<N>], opts: &CycleOptions, n: usize) -
             }
         }
         let s = block_scales(&amp, &opts.solver);
-        // The section's velocity must carry a good share of the motion.
+        // The section's velocity must carry the largest share of the motion
+        // (a small velocity crosses its level several times a period).
         let vel_max = amp[n..].iter().fold(0.0f64, |a, b| a.max(*b));
-        let _ = vel_max;
+        if index >= n && amp[index] < 0.5 * vel_max {
+            return None;
+        }
         let err = (0..N)
             .map(|i| ((list[last].z[i] - list[last - m].z[i]) / s[i]).abs())
             .fold(0.0, f64::max);
@@ -565,7 +601,16 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
     z0: [f64; N],
     opts: &CycleOptions,
 ) -> Result<Cycle<N>, CycleError> {
-    let (section, z, period, settled) = settle(sys, t0, z0, opts)?;
+    // A settling run at the looser settle_rtol that fails (chatter the
+    // tighter tolerance resolves, say) is repeated at the solver's own.
+    let (section, z, period, settled) = match settle(sys, t0, z0, opts) {
+        Err(CycleError::Integrate(_)) if opts.settle_rtol > opts.solver.rtol => {
+            let mut strict = *opts;
+            strict.settle_rtol = opts.solver.rtol;
+            settle(sys, t0, z0, &strict)?
+        }
+        other => other?,
+    };
     let mut c = shoot(sys, z, period, section, opts)?;
     c.settle_time = settled;
     Ok(c)
@@ -591,7 +636,7 @@ pub fn shoot<S: System<N> + ?Sized, const N: usize>(
     let mut z = z0;
     let mut t = period;
     // Scales from a first pass.
-    let first = period_flow(sys, &z, t, &[1.0; N], opts, None)?;
+    let first = period_flow(sys, &z, t, &[1.0; N], opts, false, None)?;
     let mut amp = [0.0; N];
     for i in 0..N {
         amp[i] = 0.5 * (first.hi[i] - first.lo[i]);
@@ -601,7 +646,7 @@ pub fn shoot<S: System<N> + ?Sized, const N: usize>(
     let mut residual;
     let mut last_step = f64::INFINITY;
     loop {
-        let p = period_flow(sys, &z, t, &s, opts, None)?;
+        let p = period_flow(sys, &z, t, &s, opts, true, None)?;
         residual = (0..N)
             .map(|i| ((p.z_end[i] - z[i]) / s[i]).abs())
             .fold(0.0, f64::max);
@@ -757,14 +802,13 @@ pub fn orbit<S: System<N> + ?Sized, const N: usize>(
     opts: &CycleOptions,
 ) -> Result<Orbit<N>, CycleError> {
     let mut o = Orbit::default();
-    let mut plain = *opts;
-    plain.magnus_substeps = 1;
     period_flow(
         sys,
         &cycle.z0,
         cycle.period,
         &[1.0; N],
-        &plain,
+        opts,
+        false,
         Some(&mut o),
     )?;
     Ok(o)

@@ -1,6 +1,7 @@
 //! One module per command.
 
 pub mod critical;
+pub mod cycle;
 pub mod listen;
 pub mod map;
 pub mod plot;
