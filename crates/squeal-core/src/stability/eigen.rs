@@ -378,10 +378,11 @@ pub fn eigenvector<const N: usize>(a: &[[f64; N]; N], lambda: Complex<f64>) -> [
     };
     let mut perm = [0usize; N];
     for k in 0..N {
+        // Pivot by |·|² (the same order as |·|, without a hypot per entry).
         let mut piv = k;
-        let mut best = lu[k][k].norm();
+        let mut best = lu[k][k].norm_sqr();
         for i in k + 1..N {
-            let v = lu[i][k].norm();
+            let v = lu[i][k].norm_sqr();
             if v > best {
                 best = v;
                 piv = i;
@@ -389,7 +390,7 @@ pub fn eigenvector<const N: usize>(a: &[[f64; N]; N], lambda: Complex<f64>) -> [
         }
         perm[k] = piv;
         lu.swap(k, piv);
-        if lu[k][k].norm() < tiny {
+        if lu[k][k].norm_sqr() < tiny * tiny {
             lu[k][k] = Complex::new(tiny, 0.0);
         }
         let pivot = lu[k][k];

@@ -241,15 +241,24 @@ fn analyse_impl<M: System<N> + ?Sized, const N: usize>(
     let (ev, bal, d) = eigen::eigenvalues_balanced(&a).ok_or(StabilityError::NoConvergence)?;
     let names = model.names();
     let n = N / 2;
+    // A real matrix's eigenvector of λ̄ is the conjugate of λ's: computed once per pair.
+    let mut done: Vec<(Complex<f64>, [Complex<f64>; N])> = Vec::with_capacity(N);
     let mut modes: Vec<Eigen> = ev
         .iter()
         .map(|&lambda| {
-            // Inverse iteration on the balanced matrix, mapped back: u = D ũ.
-            let mut u = eigen::eigenvector(&bal, lambda);
-            for (ui, di) in u.iter_mut().zip(d.iter()) {
-                *ui *= *di;
-            }
-            eigen::normalise(&mut u);
+            let pair = done.iter().find(|(l, _)| l.im != 0.0 && *l == lambda.conj());
+            let u = if let Some((_, v)) = pair {
+                v.map(|x| x.conj())
+            } else {
+                // Inverse iteration on the balanced matrix, mapped back: u = D ũ.
+                let mut u = eigen::eigenvector(&bal, lambda);
+                for (ui, di) in u.iter_mut().zip(d.iter()) {
+                    *ui *= *di;
+                }
+                eigen::normalise(&mut u);
+                done.push((lambda, u));
+                u
+            };
             let mag = lambda.norm();
             let mut e: Vec<f64> = (0..n)
                 .map(|i| {
