@@ -246,7 +246,9 @@ fn analyse_impl<M: System<N> + ?Sized, const N: usize>(
     let mut modes: Vec<Eigen> = ev
         .iter()
         .map(|&lambda| {
-            let pair = done.iter().find(|(l, _)| l.im != 0.0 && *l == lambda.conj());
+            let pair = done
+                .iter()
+                .find(|(l, _)| l.im != 0.0 && *l == lambda.conj());
             let u = if let Some((_, v)) = pair {
                 v.map(|x| x.conj())
             } else {
