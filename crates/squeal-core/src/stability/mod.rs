@@ -20,6 +20,9 @@
 //! - [`analyse`]: all eigenvalues, eigenvectors and mode descriptions;
 //! - [`max_growth_rate`]: the fast path for stability maps (eigenvalues only,
 //!   no heap allocation, ≈ 2 µs for the 8-state disc–pad model);
+//! - [`modal::analyse_matrix`]: the same analysis for a state matrix of any
+//!   size known at run time (faer for thousands of states), and complex mode
+//!   shapes ([`modal::mode_shape`]);
 //! - [`critical`]: a grid scan plus Brent's method for the parameter value
 //!   at which the stability changes.
 //!
@@ -27,6 +30,7 @@
 //! the reasons it is hand-written).
 
 pub mod eigen;
+pub mod modal;
 
 use crate::model::{Model, ModelError};
 use crate::params::ParamError;
@@ -110,8 +114,9 @@ pub struct Eigen {
     /// Index of the position coordinate with the largest share of the
     /// mode's energy (see [`Eigen::participation`]).
     pub dominant: usize,
-    /// Name of that coordinate (`Model::state_names`).
-    pub dominant_name: &'static str,
+    /// Name of that coordinate (`Model::state_names`, or the names given to
+    /// [`modal::analyse_matrix`]).
+    pub dominant_name: String,
     /// Energy share of each position coordinate `i < N/2` (sums to 1):
     /// `E_i ∝ m_i·(|u_{n+i}|² + |λ|²·|u_i|²)` with `u` the eigenvector and
     /// `n = N/2`, i.e. twice the kinetic energy of coordinate `i` counted
@@ -239,8 +244,7 @@ fn analyse_impl<M: Model<N> + ?Sized, const N: usize>(
     let (z, a) = state_matrix(model)?;
     let (ev, bal, d) = eigen::eigenvalues_balanced(&a).ok_or(StabilityError::NoConvergence)?;
     let names = model.state_names();
-    let n = N / 2;
-    let mut modes: Vec<Eigen> = ev
+    let modes: Vec<Eigen> = ev
         .iter()
         .map(|&lambda| {
             // Inverse iteration on the balanced matrix, mapped back: u = D ũ.
@@ -249,44 +253,10 @@ fn analyse_impl<M: Model<N> + ?Sized, const N: usize>(
                 *ui *= *di;
             }
             eigen::normalise(&mut u);
-            let mag = lambda.norm();
-            let mut e: Vec<f64> = (0..n)
-                .map(|i| {
-                    let m = masses.map_or(1.0, |m| m[i]);
-                    m * (u[n + i].norm_sqr() + mag * mag * u[i].norm_sqr())
-                })
-                .collect();
-            let mut total: f64 = e.iter().sum();
-            if total <= 0.0 || !total.is_finite() {
-                e = (0..n).map(|i| u[i].norm_sqr()).collect();
-                total = e.iter().sum();
-            }
-            if total > 0.0 {
-                e.iter_mut().for_each(|x| *x /= total);
-            }
-            let dominant = (0..n).max_by(|&i, &j| e[i].total_cmp(&e[j])).unwrap_or(0);
-            Eigen {
-                re: lambda.re,
-                im: lambda.im,
-                freq_hz: lambda.im.abs() / (2.0 * std::f64::consts::PI),
-                damping_ratio: if mag > 0.0 { -lambda.re / mag } else { 0.0 },
-                growing: is_growing(lambda.re, lambda.im),
-                dominant,
-                dominant_name: names.get(dominant).copied().unwrap_or(""),
-                participation: e,
-                vector: u.to_vec(),
-            }
+            modal::describe(lambda, u.to_vec(), masses, &names)
         })
         .collect();
-    modes.sort_by(|p, q| q.re.total_cmp(&p.re).then(q.im.total_cmp(&p.im)));
-    let stable = !modes.iter().any(|m| m.growing);
-    Ok(Analysis {
-        max_growth_rate: modes.first().map_or(f64::NEG_INFINITY, |m| m.re),
-        stable,
-        least_stable: 0,
-        equilibrium: z.to_vec(),
-        eigen: modes,
-    })
+    Ok(modal::finish(modes, z.to_vec()))
 }
 
 /// Fast path for stability maps: the largest growth rate σ_max (1/s) of the

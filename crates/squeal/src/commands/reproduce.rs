@@ -46,7 +46,7 @@ struct Linear {
     growing: bool,
     neutral: bool,
     /// (σ, ω, dominant) of every eigenvalue with ω ≥ 0, sorted by σ.
-    modes: Vec<(f64, f64, &'static str)>,
+    modes: Vec<(f64, f64, String)>,
 }
 
 /// Everything measured on one set.
@@ -138,7 +138,7 @@ fn linear_of(model: &AnyModel) -> Result<Linear, String> {
             .eigen
             .iter()
             .filter(|e| e.im >= 0.0)
-            .map(|e| (e.re, e.im, e.dominant_name))
+            .map(|e| (e.re, e.im, e.dominant_name.clone()))
             .collect(),
     })
 }
