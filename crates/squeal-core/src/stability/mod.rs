@@ -23,6 +23,9 @@
 //! - [`modal::analyse_matrix`]: the same analysis for a state matrix of any
 //!   size known at run time (faer for thousands of states), and complex mode
 //!   shapes ([`modal::mode_shape`]);
+//! - [`sweep::sweep`]: every eigenvalue along a one-parameter sweep, tracked
+//!   continuously (MAC + Hungarian assignment), with located onsets and
+//!   coalescences (the mode-coupling diagram);
 //! - [`critical`]: a grid scan plus Brent's method for the parameter value
 //!   at which the stability changes.
 //!
@@ -31,6 +34,7 @@
 
 pub mod eigen;
 pub mod modal;
+pub mod sweep;
 
 use crate::model::{Model, ModelError};
 use crate::params::ParamError;

@@ -71,6 +71,29 @@ pub fn eigenpairs(a: &DMatrix<f64>) -> Result<Vec<EigenPair>, StabilityError> {
     }
 }
 
+/// Every eigenvalue of `a`, without eigenvectors (same solvers and errors
+/// as [`eigenpairs`]; the values are identical to its).
+pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, StabilityError> {
+    let n = a.nrows();
+    if a.ncols() != n {
+        return Err(StabilityError::BadInput(format!(
+            "state matrix is {} × {}, not square",
+            a.nrows(),
+            a.ncols()
+        )));
+    }
+    if a.iter().any(|x| !x.is_finite()) {
+        return Err(StabilityError::NonFinite { what: "Jacobian" });
+    }
+    if n <= SMALL_MAX {
+        let rows: Vec<f64> = (0..n * n).map(|k| a[(k / n, k % n)]).collect();
+        return Workspace::eigenvalues(&rows, n)
+            .map(|(_, ev)| ev)
+            .ok_or(StabilityError::NoConvergence);
+    }
+    Ok(eigenpairs(a)?.into_iter().map(|(l, _)| l).collect())
+}
+
 /// The faer path of [`eigenpairs`] for `n > SMALL_MAX`.
 fn large_eigenpairs(mut rows: Vec<f64>, n: usize) -> Result<Vec<EigenPair>, StabilityError> {
     use faer::dyn_stack::{MemBuffer, MemStack};
