@@ -657,3 +657,166 @@ fn bad_descriptions_name_the_element_and_key() {
     });
     assert!(e.contains("not symmetric"), "{e}");
 }
+
+// ---------------------------------------------------------------------------
+// The two-pad brake against the half model
+// ---------------------------------------------------------------------------
+
+/// A symmetric two-pad brake: a disc (x_d, y_d) of mass `2m_d`, tangential
+/// stiffness `2k_dx`, damping `2c_dx` between two identical pads pressed
+/// from opposite sides (pad 1 by −N on y_p1, compression y_d − y_p1; pad 2
+/// by +N on y_p2, compression y_p2 − y_d).
+///
+/// **Correspondence.** Motions with `x_p1 = x_p2 = x_p`, `y_p2 = −y_p1 = −y_p`
+/// and `y_d = 0` stay so: both compressions equal `−y_p`, so both normal and
+/// friction forces are equal; the normal forces on the disc cancel (y_d stays
+/// at rest whatever its stiffness, i.e. its normal dof is held as if rigid);
+/// the disc's tangential equation `2m_d ẍ_d = −2k_dx x_d − 2c_dx ẋ_d − 2F_t`
+/// is the half model's times two. So the half model — disc (x_d) of mass
+/// `m_d`, one pad (x_p, y_p), compression `−y_p` — has exactly the
+/// eigenvalues of the two-pad brake's symmetric modes: each of its 6
+/// eigenvalues is one of the two-pad brake's 12.
+#[test]
+fn symmetric_two_pad_brake_contains_the_half_models_eigenvalues() {
+    let (m_d, k_dx, c_dx, m_p, k_px, c_px, k_py, c_py, n) =
+        (1.0, 1.0e9, 1.0, 0.1, 1.7e9, 0.2, 4.25e9, 0.2, 500.0);
+    let law = FrictionLaw::default();
+    let contact = |name: &str, normal: &[(&str, f64)], tangent: &[(&str, f64)]| ContactSpec {
+        name: name.into(),
+        normal: Some(terms(normal)),
+        k: Some(k_py),
+        c: Some(c_py),
+        bilateral: false,
+        normal_force: None,
+        tangent: Some(terms(tangent)),
+        v: 1.0,
+        friction: law,
+        alpha: 0.0,
+        slope: Vec::new(),
+    };
+    let half = lumped(&LumpedSpec {
+        dofs: ["x_d", "x_p", "y_p"].map(String::from).to_vec(),
+        masses: terms(&[("x_d", m_d), ("x_p", m_p), ("y_p", m_p)]),
+        springs: vec![
+            spring("disc_x", &[("x_d", 1.0)], k_dx, c_dx),
+            spring("pad_x", &[("x_p", 1.0)], k_px, c_px),
+        ],
+        forces: vec![force("brake", &[("y_p", 1.0)], -n)],
+        contacts: vec![contact(
+            "pad",
+            &[("y_p", -1.0)],
+            &[("x_d", 1.0), ("x_p", -1.0)],
+        )],
+        ..Default::default()
+    });
+    let two = lumped(&LumpedSpec {
+        dofs: ["x_d", "y_d", "x_p1", "y_p1", "x_p2", "y_p2"]
+            .map(String::from)
+            .to_vec(),
+        masses: terms(&[
+            ("x_d", 2.0 * m_d),
+            ("y_d", 2.0 * m_d),
+            ("x_p1", m_p),
+            ("y_p1", m_p),
+            ("x_p2", m_p),
+            ("y_p2", m_p),
+        ]),
+        springs: vec![
+            spring("disc_x", &[("x_d", 1.0)], 2.0 * k_dx, 2.0 * c_dx),
+            spring("disc_y", &[("y_d", 1.0)], 1.6e7, 2.0),
+            spring("pad1_x", &[("x_p1", 1.0)], k_px, c_px),
+            spring("pad2_x", &[("x_p2", 1.0)], k_px, c_px),
+        ],
+        forces: vec![
+            force("brake_1", &[("y_p1", 1.0)], -n),
+            force("brake_2", &[("y_p2", 1.0)], n),
+        ],
+        contacts: vec![
+            contact(
+                "pad1",
+                &[("y_d", 1.0), ("y_p1", -1.0)],
+                &[("x_d", 1.0), ("x_p1", -1.0)],
+            ),
+            contact(
+                "pad2",
+                &[("y_p2", 1.0), ("y_d", -1.0)],
+                &[("x_d", 1.0), ("x_p2", -1.0)],
+            ),
+        ],
+        ..Default::default()
+    });
+    let h = analyse::<_, 6>(&half).unwrap();
+    let t = analyse::<_, 12>(&two).unwrap();
+    // The disc's normal dof stays at rest (to round-off of the Newton solve;
+    // the pads' static deflection is ≈ 1.2e-7 m).
+    assert!(
+        t.equilibrium[1].abs() <= 1e-18,
+        "y_d* = {:e}",
+        t.equilibrium[1]
+    );
+    for e in &h.eigen {
+        let mag = e.re.hypot(e.im);
+        let best = t
+            .eigen
+            .iter()
+            .map(|f| (f.re - e.re).hypot(f.im - e.im))
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            best <= 1e-10 * mag,
+            "half-model eigenvalue {} {}: nearest at {best:e}",
+            e.re,
+            e.im
+        );
+    }
+    // The half model's unstable pad mode is the brake's.
+    assert!(
+        (h.max_growth_rate - t.max_growth_rate).abs() <= 1e-9 * t.max_growth_rate.abs().max(1.0)
+    );
+}
+
+/// A large lumped model through the dense path (beyond the fixed-size
+/// limit): 200 decoupled oscillators `m ẍ + c ẋ + k x = 0`, whose eigenvalues
+/// are known in closed form, `λ = −c/2m ± i·√(k/m − (c/2m)²)`.
+#[test]
+fn large_decoupled_model_has_the_closed_form_eigenvalues() {
+    use squeal_core::model::lumped::Triplets;
+    let n = 200;
+    let mut spec = LumpedSpec {
+        dofs: (1..=n).map(|i| format!("q{i}")).collect(),
+        ..Default::default()
+    };
+    let (mut mm, mut kk, mut cc) = (
+        Triplets::default(),
+        Triplets::default(),
+        Triplets::default(),
+    );
+    for t in [&mut mm, &mut kk, &mut cc] {
+        t.rows = n;
+        t.cols = n;
+    }
+    let mut want = Vec::new();
+    for i in 0..n {
+        let f = i as f64;
+        let (m, k, c) = (0.5 + 0.01 * f, 1.0e4 * (1.0 + 0.37 * f), 0.3 + 0.02 * f);
+        mm.entries.push((i, i, m));
+        kk.entries.push((i, i, k));
+        cc.entries.push((i, i, c));
+        let a = c / (2.0 * m);
+        want.push((-a, (k / m - a * a).sqrt()));
+    }
+    spec.m = Some(mm);
+    spec.k = Some(kk);
+    spec.c = Some(cc);
+    let l = lumped(&spec);
+    let ev = squeal_core::stability::lumped::eigenvalues(&l).unwrap();
+    assert_eq!(ev.len(), 2 * n);
+    for (re, im) in want {
+        for s in [1.0, -1.0] {
+            let best = ev
+                .iter()
+                .map(|e| (e.re - re).hypot(e.im - s * im))
+                .fold(f64::INFINITY, f64::min);
+            assert!(best <= 1e-10 * re.hypot(im), "{re} {im}: nearest {best:e}");
+        }
+    }
+}

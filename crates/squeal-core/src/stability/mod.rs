@@ -20,6 +20,12 @@
 //! - [`analyse`]: all eigenvalues, eigenvectors and mode descriptions;
 //! - [`max_growth_rate`]: the fast path for stability maps (eigenvalues only,
 //!   no heap allocation, ≈ 2 µs for the 8-state disc–pad model);
+//! - [`modal::analyse_matrix`]: the same analysis for a state matrix of any
+//!   size known at run time (faer for thousands of states), and complex mode
+//!   shapes ([`modal::mode_shape`]);
+//! - [`sweep::sweep`]: every eigenvalue along a one-parameter sweep, tracked
+//!   continuously (MAC + Hungarian assignment), with located onsets and
+//!   coalescences (the mode-coupling diagram);
 //! - [`critical`]: a grid scan plus Brent's method for the parameter value
 //!   at which the stability changes.
 //!
@@ -28,6 +34,8 @@
 
 pub mod eigen;
 pub mod lumped;
+pub mod modal;
+pub mod sweep;
 
 use crate::model::{ModelError, System};
 use crate::params::ParamError;
@@ -111,7 +119,8 @@ pub struct Eigen {
     /// Index of the position coordinate with the largest share of the
     /// mode's energy (see [`Eigen::participation`]).
     pub dominant: usize,
-    /// Name of that coordinate (`Model::state_names`).
+    /// Name of that coordinate (`System::names`, or the names given to
+    /// [`modal::analyse_matrix`]).
     pub dominant_name: String,
     /// Energy share of each position coordinate `i < N/2` (sums to 1):
     /// `E_i ∝ m_i·(|u_{n+i}|² + |λ|²·|u_i|²)` with `u` the eigenvector and
@@ -240,54 +249,31 @@ fn analyse_impl<M: System<N> + ?Sized, const N: usize>(
     let (z, a) = state_matrix(model)?;
     let (ev, bal, d) = eigen::eigenvalues_balanced(&a).ok_or(StabilityError::NoConvergence)?;
     let names = model.names();
-    let n = N / 2;
-    let mut modes: Vec<Eigen> = ev
+    // A real matrix's eigenvector of λ̄ is the conjugate of λ's: computed once per pair.
+    let mut done: Vec<(Complex<f64>, Vec<Complex<f64>>)> = Vec::with_capacity(N);
+    let modes: Vec<Eigen> = ev
         .iter()
         .map(|&lambda| {
-            // Inverse iteration on the balanced matrix, mapped back: u = D ũ.
-            let mut u = eigen::eigenvector(&bal, lambda);
-            for (ui, di) in u.iter_mut().zip(d.iter()) {
-                *ui *= *di;
-            }
-            eigen::normalise(&mut u);
-            let mag = lambda.norm();
-            let mut e: Vec<f64> = (0..n)
-                .map(|i| {
-                    let m = masses.map_or(1.0, |m| m[i]);
-                    m * (u[n + i].norm_sqr() + mag * mag * u[i].norm_sqr())
-                })
-                .collect();
-            let mut total: f64 = e.iter().sum();
-            if total <= 0.0 || !total.is_finite() {
-                e = (0..n).map(|i| u[i].norm_sqr()).collect();
-                total = e.iter().sum();
-            }
-            if total > 0.0 {
-                e.iter_mut().for_each(|x| *x /= total);
-            }
-            let dominant = (0..n).max_by(|&i, &j| e[i].total_cmp(&e[j])).unwrap_or(0);
-            Eigen {
-                re: lambda.re,
-                im: lambda.im,
-                freq_hz: lambda.im.abs() / (2.0 * std::f64::consts::PI),
-                damping_ratio: if mag > 0.0 { -lambda.re / mag } else { 0.0 },
-                growing: is_growing(lambda.re, lambda.im),
-                dominant,
-                dominant_name: names.get(dominant).cloned().unwrap_or_default(),
-                participation: e,
-                vector: u.to_vec(),
-            }
+            let pair = done
+                .iter()
+                .find(|(l, _)| l.im != 0.0 && *l == lambda.conj());
+            let u = if let Some((_, v)) = pair {
+                v.iter().map(|x| x.conj()).collect()
+            } else {
+                // Inverse iteration on the balanced matrix, mapped back: u = D ũ.
+                let mut u = eigen::eigenvector(&bal, lambda);
+                for (ui, di) in u.iter_mut().zip(d.iter()) {
+                    *ui *= *di;
+                }
+                eigen::normalise(&mut u);
+                let u = u.to_vec();
+                done.push((lambda, u.clone()));
+                u
+            };
+            modal::describe(lambda, u, masses, &names)
         })
         .collect();
-    modes.sort_by(|p, q| q.re.total_cmp(&p.re).then(q.im.total_cmp(&p.im)));
-    let stable = !modes.iter().any(|m| m.growing);
-    Ok(Analysis {
-        max_growth_rate: modes.first().map_or(f64::NEG_INFINITY, |m| m.re),
-        stable,
-        least_stable: 0,
-        equilibrium: z.to_vec(),
-        eigen: modes,
-    })
+    Ok(modal::finish(modes, z.to_vec()))
 }
 
 /// Fast path for stability maps: the largest growth rate σ_max (1/s) of the
