@@ -550,7 +550,7 @@ fn not_settled_cause<const N: usize>(returns: &[Vec<Return<N>>]) -> String {
     if returns.iter().all(|r| r.len() < 2) {
         "the motion does not oscillate (it may settle on steady sliding or stick)".into()
     } else {
-        "the returns to the section never repeated (the motion may be quasi-periodic, chaotic or still growing)".into()
+        "the returns to the section never repeated (the oscillation may be dying out onto steady sliding, still growing, quasi-periodic or chaotic)".into()
     }
 }
 
@@ -572,6 +572,28 @@ fn periodic<const N: usize>(
             for i in 0..N {
                 amp[i] = f64::max(amp[i], 0.5 * (r.hi[i] - r.lo[i]));
             }
+        }
+        // The oscillation must neither decay nor grow between the two halves
+        // of the window, and stand clear of the integrator's tolerance.
+        let mut amp1 = [0.0f64; N];
+        let mut amp2 = [0.0f64; N];
+        for (k, r) in list[last + 1 - 2 * m..=last].iter().enumerate() {
+            let a = if k < m { &mut amp1 } else { &mut amp2 };
+            for i in 0..N {
+                a[i] = a[i].max(0.5 * (r.hi[i] - r.lo[i]));
+            }
+        }
+        let (v1, v2) = (
+            amp1[n..].iter().fold(0.0f64, |a, b| a.max(*b)),
+            amp2[n..].iter().fold(0.0f64, |a, b| a.max(*b)),
+        );
+        let floor = 1e4
+            * opts
+                .solver
+                .atol_vel
+                .unwrap_or(crate::integrate::DEFAULT_ATOL_VEL);
+        if v2 <= floor || (v2 - v1).abs() > opts.settle_tol * v2 {
+            continue;
         }
         let s = block_scales(&amp, &opts.solver);
         // The section's velocity must carry the largest share of the motion

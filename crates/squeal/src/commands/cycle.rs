@@ -29,7 +29,7 @@ pub struct CycleArgs {
     #[arg(long, default_value_t = 20_000_000)]
     pub settle_steps: u64,
     /// Most simulated time spent settling (s), whatever the scenario's duration.
-    #[arg(long, default_value_t = 1000.0)]
+    #[arg(long, default_value_t = 1000.0, allow_hyphen_values = true)]
     pub settle_time: f64,
     /// Settled when two returns to the section agree to this, relative to
     /// the orbit's amplitude (Newton's method does the rest).
