@@ -47,6 +47,8 @@ enum Command {
     Critical(commands::critical::CriticalArgs),
     /// The limit cycle a scenario settles on: period, Floquet multipliers, amplitudes, events.
     Cycle(commands::cycle::CycleArgs),
+    /// Follow the limit cycle in one parameter: branch.csv, bifurcations, diagram.
+    Branch(commands::branch::BranchArgs),
     /// Re-do the thesis: 40 sets, Appendix A, the seven conclusions checked, a report.
     Reproduce(commands::reproduce::ReproduceArgs),
     /// Redraw the pictures of a saved run without re-simulating.
@@ -72,6 +74,7 @@ fn main() -> ExitCode {
         Command::Critical(a) => commands::critical::run(a),
         Command::Listen(a) => commands::listen::run(a),
         Command::Cycle(a) => commands::cycle::run(a),
+        Command::Branch(a) => commands::branch::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -84,3 +84,53 @@ fn no_cycle_is_a_clear_error() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("no periodic orbit"), "{err}");
 }
+
+#[test]
+fn coulomb_belt_branch_over_v_is_exact() {
+    // Stick-slip for V < ω(x_s − x_k)… and beyond: the exact period and
+    // amplitude R = √((x_s − x_k)² + (V/ω)²) at every point that sticks.
+    let d = tempfile::tempdir().unwrap();
+    let out = squeal(
+        d.path(),
+        &[
+            "branch",
+            "belt-coulomb",
+            "--param",
+            "V=0.02:0.09:8",
+            "--out",
+            "b",
+        ],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(d.path().join("b/branch.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "V,period,amplitude_x,amplitude_v,max_multiplier,stable,events_stick,events_slip,events_reverse,events_separate,events_contact"
+    );
+    let (omega, xi) = (100.0f64, 0.001f64);
+    let mut rows = 0;
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let v: f64 = f[0].parse().unwrap();
+        let period: f64 = f[1].parse().unwrap();
+        let amp_x: f64 = f[2].parse().unwrap();
+        let phi = (v / omega).atan2(xi);
+        let want = 2.0 * xi / v + (std::f64::consts::PI + 2.0 * phi) / omega;
+        let r = (xi * xi + (v / omega).powi(2)).sqrt();
+        assert!(
+            (period - want).abs() <= 1e-6 * want,
+            "V = {v}: {period} vs {want}"
+        );
+        assert!((amp_x - r).abs() <= 1e-2 * r, "V = {v}: {amp_x} vs {r}");
+        assert_eq!(f[5], "true");
+        assert_eq!((f[6], f[7]), ("1", "1"));
+        rows += 1;
+    }
+    assert_eq!(rows, 8);
+    assert!(d.path().join("b/branch.png").is_file());
+}

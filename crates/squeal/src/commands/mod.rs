@@ -1,5 +1,6 @@
 //! One module per command.
 
+pub mod branch;
 pub mod critical;
 pub mod cycle;
 pub mod listen;
