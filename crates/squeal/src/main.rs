@@ -45,6 +45,8 @@ enum Command {
     Map(commands::map::MapArgs),
     /// Locate the parameter value where steady sliding changes stability.
     Critical(commands::critical::CriticalArgs),
+    /// Every eigenvalue along a one-parameter sweep, modes tracked: sweep.csv and the mode-coupling diagram.
+    Sweep(commands::sweep::SweepArgs),
     /// Re-do the thesis: 40 sets, Appendix A, the seven conclusions checked, a report.
     Reproduce(commands::reproduce::ReproduceArgs),
     /// Redraw the pictures of a saved run without re-simulating.
@@ -68,6 +70,7 @@ fn main() -> ExitCode {
         Command::Stability(a) => commands::stability::run(a),
         Command::Map(a) => commands::map::run(a),
         Command::Critical(a) => commands::critical::run(a),
+        Command::Sweep(a) => commands::sweep::run(a),
         Command::Listen(a) => commands::listen::run(a),
     };
     match result {

@@ -22,7 +22,8 @@
 //! `n` coordinates, the position part `q = (u_0 … u_{n−1})` of the
 //! eigenvector, scaled so that its largest component (the first, on ties) is
 //! real and equal to 1: each coordinate's amplitude is in `[0, 1]` and its
-//! phase (degrees, in `(−180, 180]`) is measured from that coordinate. The
+//! phase (degrees, in `(−180, 180]`) is measured from that coordinate (0
+//! for an entry below [`PHASE_FLOOR`], zero to working precision). The
 //! velocity part is `λ·q` and carries no further information.
 
 use super::eigen::{self, Workspace};
@@ -289,18 +290,25 @@ pub fn mode_shape(mode: &Eigen) -> Vec<Complex<f64>> {
 }
 
 /// Amplitude and phase (degrees, `(−180, 180]`) of each entry of a
-/// [`mode_shape`].
+/// [`mode_shape`]. An entry with amplitude below [`PHASE_FLOOR`] is zero to
+/// working precision: its phase would be round-off and is reported as 0.
 pub fn amplitude_phase(shape: &[Complex<f64>]) -> Vec<(f64, f64)> {
     shape
         .iter()
         .map(|c| {
-            let phase = if c.norm() > 0.0 {
+            let amp = c.norm();
+            let phase = if amp > PHASE_FLOOR {
                 c.arg().to_degrees()
             } else {
                 0.0
             };
             // arg ∈ [−π, π]: fold −180 onto +180.
-            (c.norm(), if phase <= -180.0 { 180.0 } else { phase })
+            (amp, if phase <= -180.0 { 180.0 } else { phase })
         })
         .collect()
 }
+
+/// Relative amplitude (to the reference entry, 1) below which a mode-shape
+/// entry's phase is not reported ([`amplitude_phase`]): ≈ 5000 ε, the
+/// round-off of an eigenvector component that is exactly zero.
+pub const PHASE_FLOOR: f64 = 1e-12;

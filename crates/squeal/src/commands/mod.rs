@@ -8,3 +8,4 @@ pub mod reproduce;
 pub mod scenario;
 pub mod simulate;
 pub mod stability;
+pub mod sweep;
