@@ -248,18 +248,26 @@ fn analyse_impl<M: Model<N> + ?Sized, const N: usize>(
     let (z, a) = state_matrix(model)?;
     let (ev, bal, d) = eigen::eigenvalues_balanced(&a).ok_or(StabilityError::NoConvergence)?;
     let names = model.state_names();
-    let modes: Vec<Eigen> = ev
-        .iter()
-        .map(|&lambda| {
-            // Inverse iteration on the balanced matrix, mapped back: u = D ũ.
-            let mut u = eigen::eigenvector(&bal, lambda);
-            for (ui, di) in u.iter_mut().zip(d.iter()) {
-                *ui *= *di;
+    let mut modes: Vec<Eigen> = Vec::with_capacity(N);
+    for (k, &lambda) in ev.iter().enumerate() {
+        // The second of a conjugate pair (hqr returns them adjacent and exactly
+        // conjugate) has the conjugate eigenvector: no second inverse iteration.
+        let u = match modes.last() {
+            Some(prev) if k > 0 && lambda.im != 0.0 && ev[k - 1] == lambda.conj() => {
+                prev.vector.iter().map(|c| c.conj()).collect()
             }
-            eigen::normalise(&mut u);
-            modal::describe(lambda, u.to_vec(), masses, &names)
-        })
-        .collect();
+            _ => {
+                // Inverse iteration on the balanced matrix, mapped back: u = D ũ.
+                let mut u = eigen::eigenvector(&bal, lambda);
+                for (ui, di) in u.iter_mut().zip(d.iter()) {
+                    *ui *= *di;
+                }
+                eigen::normalise(&mut u);
+                u.to_vec()
+            }
+        };
+        modes.push(modal::describe(lambda, u, masses, &names));
+    }
     Ok(modal::finish(modes, z.to_vec()))
 }
 
