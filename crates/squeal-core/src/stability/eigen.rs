@@ -436,9 +436,10 @@ pub fn eigenvector_flat(
     };
     for k in 0..n {
         let mut piv = k;
-        let mut best = lu[k * n + k].norm();
+        // Partial pivoting by |·|², not |·| (hypot): same order, no libm call.
+        let mut best = lu[k * n + k].norm_sqr();
         for i in k + 1..n {
-            let v = lu[i * n + k].norm();
+            let v = lu[i * n + k].norm_sqr();
             if v > best {
                 best = v;
                 piv = i;
@@ -450,17 +451,20 @@ pub fn eigenvector_flat(
                 lu.swap(k * n + j, piv * n + j);
             }
         }
-        if lu[k * n + k].norm() < tiny {
+        let p2 = lu[k * n + k].norm_sqr();
+        if p2 == 0.0 || p2 < tiny * tiny {
             lu[k * n + k] = Complex::new(tiny, 0.0);
         }
         let pivot = lu[k * n + k];
-        for i in k + 1..n {
-            let f = lu[i * n + k] / pivot;
-            lu[i * n + k] = f;
+        // Row slices instead of indices: same operations, no bounds checks.
+        let (top, below) = lu.split_at_mut((k + 1) * n);
+        let row_k = &top[k * n + k + 1..(k + 1) * n];
+        for row_i in below.chunks_exact_mut(n) {
+            let f = row_i[k] / pivot;
+            row_i[k] = f;
             if f != zero {
-                for j in k + 1..n {
-                    let u = lu[k * n + j];
-                    lu[i * n + j] -= f * u;
+                for (a, &u) in row_i[k + 1..].iter_mut().zip(row_k) {
+                    *a -= f * u;
                 }
             }
         }
@@ -473,21 +477,21 @@ pub fn eigenvector_flat(
         for k in 0..n {
             x.swap(k, perm[k]);
         }
-        for i in 0..n {
+        for (i, row) in lu.chunks_exact(n).enumerate() {
             let mut s = x[i];
-            for j in 0..i {
-                s -= lu[i * n + j] * x[j];
+            for (l, xj) in row[..i].iter().zip(&x[..i]) {
+                s -= l * xj;
             }
             x[i] = s;
         }
-        for i in (0..n).rev() {
+        for (i, row) in lu.chunks_exact(n).enumerate().rev() {
             let mut s = x[i];
-            for j in i + 1..n {
-                s -= lu[i * n + j] * x[j];
+            for (u, xj) in row[i + 1..].iter().zip(&x[i + 1..]) {
+                s -= u * xj;
             }
-            x[i] = s / lu[i * n + i];
+            x[i] = s / row[i];
         }
-        let m = x.iter().map(|c| c.norm()).fold(0.0, f64::max);
+        let m = x.iter().map(|c| c.norm_sqr()).fold(0.0, f64::max).sqrt();
         if !(m > 0.0 && m.is_finite()) {
             break;
         }
@@ -503,7 +507,7 @@ pub fn eigenvector_flat(
 pub fn normalise(x: &mut [Complex<f64>]) {
     let mut big = 0;
     for i in 0..x.len() {
-        if x[i].norm() > x[big].norm() {
+        if x[i].norm_sqr() > x[big].norm_sqr() {
             big = i;
         }
     }
