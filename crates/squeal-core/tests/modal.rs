@@ -352,4 +352,10 @@ fn bad_matrices_are_refused_with_a_reason() {
         Err(StabilityError::BadInput(_))
     ));
     assert!(eigenpairs(&DMatrix::<f64>::zeros(0, 0)).unwrap().is_empty());
+    // The zero matrix: every pivot of A − 0·I is zero; eigenvectors still finite, unit.
+    for (l, u) in eigenpairs(&DMatrix::<f64>::zeros(4, 4)).unwrap() {
+        assert_eq!(l, Complex::new(0.0, 0.0));
+        let n2: f64 = u.iter().map(|c| c.norm_sqr()).sum();
+        assert!((n2 - 1.0).abs() < 1e-15, "{u:?}");
+    }
 }

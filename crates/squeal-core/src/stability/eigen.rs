@@ -429,14 +429,16 @@ pub fn eigenvector_flat(
         lu[i * n + i] -= lambda;
         norm = norm.max(row);
     }
+    // (For a zero matrix, √MIN_POSITIVE: its square, compared with |pivot|²
+    // below, must not underflow to 0.)
     let tiny = if norm > 0.0 {
         f64::EPSILON * norm
     } else {
-        f64::MIN_POSITIVE
+        f64::MIN_POSITIVE.sqrt()
     };
     for k in 0..n {
+        // Pivot by |·|² (the same order as |·|, without a hypot per entry).
         let mut piv = k;
-        // Partial pivoting by |·|², not |·| (hypot): same order, no libm call.
         let mut best = lu[k * n + k].norm_sqr();
         for i in k + 1..n {
             let v = lu[i * n + k].norm_sqr();
@@ -451,8 +453,7 @@ pub fn eigenvector_flat(
                 lu.swap(k * n + j, piv * n + j);
             }
         }
-        let p2 = lu[k * n + k].norm_sqr();
-        if p2 == 0.0 || p2 < tiny * tiny {
+        if lu[k * n + k].norm_sqr() < tiny * tiny {
             lu[k * n + k] = Complex::new(tiny, 0.0);
         }
         let pivot = lu[k * n + k];
