@@ -248,26 +248,30 @@ fn analyse_impl<M: Model<N> + ?Sized, const N: usize>(
     let (z, a) = state_matrix(model)?;
     let (ev, bal, d) = eigen::eigenvalues_balanced(&a).ok_or(StabilityError::NoConvergence)?;
     let names = model.state_names();
-    let mut modes: Vec<Eigen> = Vec::with_capacity(N);
-    for (k, &lambda) in ev.iter().enumerate() {
-        // The second of a conjugate pair (hqr returns them adjacent and exactly
-        // conjugate) has the conjugate eigenvector: no second inverse iteration.
-        let u = match modes.last() {
-            Some(prev) if k > 0 && lambda.im != 0.0 && ev[k - 1] == lambda.conj() => {
-                prev.vector.iter().map(|c| c.conj()).collect()
-            }
-            _ => {
+    // A real matrix's eigenvector of λ̄ is the conjugate of λ's: computed once per pair.
+    let mut done: Vec<(Complex<f64>, Vec<Complex<f64>>)> = Vec::with_capacity(N);
+    let modes: Vec<Eigen> = ev
+        .iter()
+        .map(|&lambda| {
+            let pair = done
+                .iter()
+                .find(|(l, _)| l.im != 0.0 && *l == lambda.conj());
+            let u = if let Some((_, v)) = pair {
+                v.iter().map(|x| x.conj()).collect()
+            } else {
                 // Inverse iteration on the balanced matrix, mapped back: u = D ũ.
                 let mut u = eigen::eigenvector(&bal, lambda);
                 for (ui, di) in u.iter_mut().zip(d.iter()) {
                     *ui *= *di;
                 }
                 eigen::normalise(&mut u);
-                u.to_vec()
-            }
-        };
-        modes.push(modal::describe(lambda, u, masses, &names));
-    }
+                let u = u.to_vec();
+                done.push((lambda, u.clone()));
+                u
+            };
+            modal::describe(lambda, u, masses, &names)
+        })
+        .collect();
     Ok(modal::finish(modes, z.to_vec()))
 }
 
