@@ -32,6 +32,9 @@ fn same_as_fixed<M: Model<N> + Inertia, const N: usize>(model: &M, label: &str) 
             d.re,
             d.im
         );
+        // In fact the same operations in the same order: bit for bit.
+        assert_eq!((f.re, f.im), (d.re, d.im), "{label}");
+        assert_eq!(f.vector, d.vector, "{label}");
         assert_eq!(f.dominant_name, d.dominant_name, "{label}");
         for (x, y) in f.vector.iter().zip(&d.vector) {
             assert!((x - y).norm() <= 1e-12, "{label}: eigenvector {x} vs {y}");
