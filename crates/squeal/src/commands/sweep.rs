@@ -5,7 +5,6 @@
 
 use crate::commands::map::{parse_axis, unit_of};
 use crate::commands::simulate::resolve;
-use crate::commands::stability::stability_error;
 use crate::model::AnyModel;
 use crate::run::{RunError, Staging};
 use crate::scenario::InputError;
@@ -44,11 +43,18 @@ pub fn model_state_matrix(model: &AnyModel) -> Result<(DMatrix<f64>, Vec<f64>), 
     })
 }
 
-/// Sweep `name` over `values` for a built-in model.
-pub fn sweep_model(model: &AnyModel, name: &str, values: &[f64]) -> Result<Sweep, StabilityError> {
+/// Sweep `name` over `values` for a built-in model. On failure, also the
+/// parameter value where it happened.
+pub fn sweep_model(
+    model: &AnyModel,
+    name: &str,
+    values: &[f64],
+) -> Result<Sweep, (StabilityError, f64)> {
+    let mut at = f64::NAN;
     sweep(
         values,
         |p| {
+            at = p;
             let mut m = *model;
             m.set(name, p)?;
             m.validate()?;
@@ -56,6 +62,7 @@ pub fn sweep_model(model: &AnyModel, name: &str, values: &[f64]) -> Result<Sweep
         },
         &SweepOptions::default(),
     )
+    .map_err(|e| (e, at))
 }
 
 fn num(x: f64) -> String {
@@ -75,11 +82,15 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", sc.name)));
     crate::run::check_dest(&dest)?;
-    let sw = sweep_model(&sc.model, &axis.name, &axis.values).map_err(|e| match e {
-        StabilityError::NoSteadySliding(_) | StabilityError::Param(_) => {
+    let sw = sweep_model(&sc.model, &axis.name, &axis.values).map_err(|(e, at)| match e {
+        StabilityError::Param(_) => {
             RunError::Input(InputError(format!("--param {}: {e}", a.param)))
         }
-        other => stability_error(other),
+        StabilityError::NoSteadySliding(_) => RunError::Input(InputError(format!(
+            "--param {}: at {} = {at}: {e}",
+            a.param, axis.name
+        ))),
+        other => RunError::Numerical(format!("eigen-analysis at {} = {at}: {other}", axis.name)),
     })?;
     let stage = Staging::new(&dest)?;
     let path = stage.path("sweep.csv");
