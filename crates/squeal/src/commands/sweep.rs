@@ -5,7 +5,6 @@
 
 use crate::commands::map::{parse_axis, unit_of};
 use crate::commands::simulate::resolve;
-use crate::commands::stability::stability_error;
 use crate::model::AnyModel;
 use crate::run::{RunError, Staging};
 use crate::scenario::InputError;
@@ -47,11 +46,18 @@ pub fn model_state_matrix(model: &AnyModel) -> Result<(DMatrix<f64>, Vec<f64>), 
     })
 }
 
-/// Sweep `name` over `values` for any model (built-in or lumped).
-pub fn sweep_model(model: &AnyModel, name: &str, values: &[f64]) -> Result<Sweep, StabilityError> {
+/// Sweep `name` over `values` for any model (built-in or lumped). On
+/// failure, also the parameter value where it happened.
+pub fn sweep_model(
+    model: &AnyModel,
+    name: &str,
+    values: &[f64],
+) -> Result<Sweep, (StabilityError, f64)> {
+    let mut at = f64::NAN;
     sweep(
         values,
         |p| {
+            at = p;
             let mut m = model.clone();
             m.set(name, p)?;
             m.validate()?;
@@ -59,6 +65,7 @@ pub fn sweep_model(model: &AnyModel, name: &str, values: &[f64]) -> Result<Sweep
         },
         &SweepOptions::default(),
     )
+    .map_err(|e| (e, at))
 }
 
 fn num(x: f64) -> String {
@@ -78,11 +85,15 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", sc.name)));
     crate::run::check_dest(&dest)?;
-    let sw = sweep_model(&sc.model, &axis.name, &axis.values).map_err(|e| match e {
-        StabilityError::NoSteadySliding(_) | StabilityError::Param(_) => {
+    let sw = sweep_model(&sc.model, &axis.name, &axis.values).map_err(|(e, at)| match e {
+        StabilityError::Param(_) => {
             RunError::Input(InputError(format!("--param {}: {e}", a.param)))
         }
-        other => stability_error(other),
+        StabilityError::NoSteadySliding(_) => RunError::Input(InputError(format!(
+            "--param {}: at {} = {at}: {e}",
+            a.param, axis.name
+        ))),
+        other => RunError::Numerical(format!("eigen-analysis at {} = {at}: {other}", axis.name)),
     })?;
     let stage = Staging::new(&dest)?;
     let path = stage.path("sweep.csv");
