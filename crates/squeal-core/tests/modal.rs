@@ -32,6 +32,9 @@ fn same_as_fixed<M: Model<N> + Inertia, const N: usize>(model: &M, label: &str) 
             d.re,
             d.im
         );
+        // In fact the same operations in the same order: bit for bit.
+        assert_eq!((f.re, f.im), (d.re, d.im), "{label}");
+        assert_eq!(f.vector, d.vector, "{label}");
         assert_eq!(f.dominant_name, d.dominant_name, "{label}");
         for (x, y) in f.vector.iter().zip(&d.vector) {
             assert!((x - y).norm() <= 1e-12, "{label}: eigenvector {x} vs {y}");
@@ -352,4 +355,10 @@ fn bad_matrices_are_refused_with_a_reason() {
         Err(StabilityError::BadInput(_))
     ));
     assert!(eigenpairs(&DMatrix::<f64>::zeros(0, 0)).unwrap().is_empty());
+    // The zero matrix: every pivot of A − 0·I is zero; eigenvectors still finite, unit.
+    for (l, u) in eigenpairs(&DMatrix::<f64>::zeros(4, 4)).unwrap() {
+        assert_eq!(l, Complex::new(0.0, 0.0));
+        let n2: f64 = u.iter().map(|c| c.norm_sqr()).sum();
+        assert!((n2 - 1.0).abs() < 1e-15, "{u:?}");
+    }
 }

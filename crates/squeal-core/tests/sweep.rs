@@ -273,3 +273,37 @@ fn bad_sweeps_are_refused() {
     let r = sweep(&[0.1, 0.2], |mu| hoffmann_at(&h, -mu - 1.0), &o);
     assert!(matches!(r, Err(StabilityError::Param(_))), "{r:?}");
 }
+
+/// Ten uncoupled oscillators (20 states, more than `CANDIDATES`): ω_i = i + 1
+/// for the first nine, and the tenth sweeps ω = p across all of them. Every
+/// branch keeps its oscillator (identified by its shape, a unit vector).
+#[test]
+fn a_mode_sweeping_through_nine_others_keeps_every_identity() {
+    let n = 10;
+    let f = |p: f64| -> Result<(DMatrix<f64>, Vec<f64>), StabilityError> {
+        let mut a = DMatrix::<f64>::zeros(2 * n, 2 * n);
+        for i in 0..n {
+            let w = if i + 1 == n { p } else { (i + 1) as f64 };
+            a[(i, n + i)] = 1.0;
+            a[(n + i, i)] = -w * w;
+            a[(n + i, n + i)] = -0.02 * w;
+        }
+        Ok((a, vec![0.0; 2 * n]))
+    };
+    let values = linspace(0.55, 10.45, 67);
+    let sw = sweep(&values, f, &SweepOptions::default()).unwrap();
+    assert_eq!(sw.listed.len(), n);
+    // Mode order at the first point: the sweeping oscillator (ω = 0.55) first.
+    for (k, &p) in values.iter().enumerate() {
+        for m in 0..n {
+            let w = if m == 0 { p } else { m as f64 };
+            let want = w * (1.0 - 0.0001f64).sqrt();
+            let got = mode(&sw, m, k).im;
+            assert!(
+                (got - want).abs() < 1e-9 * w,
+                "p = {p}: mode {} at {got}, want {want}",
+                m + 1
+            );
+        }
+    }
+}

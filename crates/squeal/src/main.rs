@@ -49,6 +49,8 @@ enum Command {
     Cycle(commands::cycle::CycleArgs),
     /// Follow the limit cycle in one parameter: branch.csv, bifurcations, diagram.
     Branch(commands::branch::BranchArgs),
+    /// Every eigenvalue along a one-parameter sweep, modes tracked: sweep.csv and the mode-coupling diagram.
+    Sweep(commands::sweep::SweepArgs),
     /// Re-do the thesis: 40 sets, Appendix A, the seven conclusions checked, a report.
     Reproduce(commands::reproduce::ReproduceArgs),
     /// Redraw the pictures of a saved run without re-simulating.
@@ -72,6 +74,7 @@ fn main() -> ExitCode {
         Command::Stability(a) => commands::stability::run(a),
         Command::Map(a) => commands::map::run(a),
         Command::Critical(a) => commands::critical::run(a),
+        Command::Sweep(a) => commands::sweep::run(a),
         Command::Listen(a) => commands::listen::run(a),
         Command::Cycle(a) => commands::cycle::run(a),
         Command::Branch(a) => commands::branch::run(a),

@@ -217,7 +217,14 @@ pub struct Staging {
 }
 
 /// Files by which an existing folder is recognised as squeal's own output.
-const MARKERS: [&str; 4] = ["summary.json", "map.csv", "report.md", "conclusions.json"];
+const MARKERS: [&str; 6] = [
+    "summary.json",
+    "map.csv",
+    "report.md",
+    "conclusions.json",
+    "sweep.csv",
+    "modes.csv",
+];
 
 /// Check, before any work, that `dest` may be written: it does not exist, or
 /// it is an empty folder, or a folder squeal wrote before (which is replaced).

@@ -336,3 +336,40 @@ fn bad_lumped_files_exit_2_naming_element_and_key() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("mass.x_p"));
 }
+
+#[test]
+fn sweep_of_the_lumped_hoffmann_finds_the_built_ins_coalescence() {
+    let d = tempfile::tempdir().unwrap();
+    let f = scenarios().join("hoffmann.toml");
+    let a = json(&squeal(
+        d.path(),
+        &[
+            "sweep",
+            f.to_str().unwrap(),
+            "--set",
+            "belt.mu_s=2",
+            "--param",
+            "belt.mu_k=0.1:0.5:41",
+            "--json",
+            "--out",
+            "a",
+        ],
+    ));
+    let b = json(&squeal(
+        d.path(),
+        &[
+            "sweep",
+            "hoffmann",
+            "--param",
+            "mu=0.1:0.5:41",
+            "--json",
+            "--out",
+            "b",
+        ],
+    ));
+    let (oa, ob) = (&a["onsets"][0], &b["onsets"][0]);
+    assert_eq!(oa["coalescence"], true);
+    let (x, y) = (oa["value"].as_f64().unwrap(), ob["value"].as_f64().unwrap());
+    assert!((x - y).abs() <= 1e-9 * y, "{x} vs {y}");
+    assert!(d.path().join("a/sweep.csv").is_file());
+}

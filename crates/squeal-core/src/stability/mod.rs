@@ -2,7 +2,7 @@
 //!
 //! At the steady-sliding equilibrium `z*` of a model (all velocities zero,
 //! sliding velocity `v = V`), the slip equations linearise to `ż = A z` with
-//! `A = ∂f/∂z(z*)` the model's analytic Jacobian ([`Model::jacobian`]). Its
+//! `A = ∂f/∂z(z*)` the model's analytic Jacobian ([`System::state_jacobian`]). Its
 //! eigenvalues `λ = σ ± iω` give each mode's growth rate σ (1/s), frequency
 //! `ω/2π` and damping ratio `−σ/|λ|`; by Lyapunov's indirect method the
 //! equilibrium is asymptotically stable if every σ < 0 and unstable if some

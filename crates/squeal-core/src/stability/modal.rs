@@ -22,7 +22,8 @@
 //! `n` coordinates, the position part `q = (u_0 … u_{n−1})` of the
 //! eigenvector, scaled so that its largest component (the first, on ties) is
 //! real and equal to 1: each coordinate's amplitude is in `[0, 1]` and its
-//! phase (degrees, in `(−180, 180]`) is measured from that coordinate. The
+//! phase (degrees, in `(−180, 180]`) is measured from that coordinate (0
+//! for an entry below [`PHASE_FLOOR`], zero to working precision). The
 //! velocity part is `λ·q` and carries no further information.
 
 use super::eigen::{self, Workspace};
@@ -62,17 +63,27 @@ pub fn eigenpairs(a: &DMatrix<f64>) -> Result<Vec<EigenPair>, StabilityError> {
     let rows: Vec<f64> = (0..n * n).map(|k| a[(k / n, k % n)]).collect();
     if n <= SMALL_MAX {
         let (mut ws, ev) = Workspace::eigenvalues(&rows, n).ok_or(StabilityError::NoConvergence)?;
-        Ok(ev
-            .into_iter()
-            .map(|lambda| (lambda, ws.eigenvector(lambda)))
-            .collect())
+        let mut out: Vec<EigenPair> = Vec::with_capacity(n);
+        for (k, &lambda) in ev.iter().enumerate() {
+            // The second of a conjugate pair (adjacent, exactly conjugate) has
+            // the conjugate eigenvector: as in `super::analyse`.
+            let u = match out.last() {
+                Some((_, prev)) if k > 0 && lambda.im != 0.0 && ev[k - 1] == lambda.conj() => {
+                    prev.iter().map(|c| c.conj()).collect()
+                }
+                _ => ws.eigenvector(lambda),
+            };
+            out.push((lambda, u));
+        }
+        Ok(out)
     } else {
         large_eigenpairs(rows, n)
     }
 }
 
-/// Every eigenvalue of `a`, without eigenvectors (same solvers and errors
-/// as [`eigenpairs`]; the values are identical to its).
+/// Every eigenvalue of `a`, without eigenvectors: the same solvers and
+/// errors as [`eigenpairs`] (identical values up to [`SMALL_MAX`] states;
+/// above, faer's eigenvalue-only QR, equal to round-off).
 pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, StabilityError> {
     let n = a.nrows();
     if a.ncols() != n {
@@ -85,46 +96,75 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, StabilityError
     if a.iter().any(|x| !x.is_finite()) {
         return Err(StabilityError::NonFinite { what: "Jacobian" });
     }
+    let mut rows: Vec<f64> = (0..n * n).map(|k| a[(k / n, k % n)]).collect();
     if n <= SMALL_MAX {
-        let rows: Vec<f64> = (0..n * n).map(|k| a[(k / n, k % n)]).collect();
         return Workspace::eigenvalues(&rows, n)
             .map(|(_, ev)| ev)
             .ok_or(StabilityError::NoConvergence);
     }
-    Ok(eigenpairs(a)?.into_iter().map(|(l, _)| l).collect())
+    let mut d = vec![1.0; n];
+    eigen::balance_flat(&mut rows, n, &mut d);
+    let (_, s_re, s_im) = faer_evd(&rows, n, false)?;
+    (0..n)
+        .map(|j| {
+            let (re, im) = (s_re[j], s_im[j]);
+            if re.is_finite() && im.is_finite() {
+                Ok(Complex::new(re, im))
+            } else {
+                Err(StabilityError::NoConvergence)
+            }
+        })
+        .collect()
 }
 
-/// The faer path of [`eigenpairs`] for `n > SMALL_MAX`.
-fn large_eigenpairs(mut rows: Vec<f64>, n: usize) -> Result<Vec<EigenPair>, StabilityError> {
+/// faer's real non-symmetric eigendecomposition of the row-major `n × n`
+/// matrix `rows`, sequential: right eigenvectors (if `vectors`; faer's real
+/// packing: a conjugate pair's columns hold Re and Im of the vector of the
+/// `+` eigenvalue), and the real and imaginary parts of the eigenvalues.
+#[allow(clippy::type_complexity)]
+fn faer_evd(
+    rows: &[f64],
+    n: usize,
+    vectors: bool,
+) -> Result<(Option<faer::Mat<f64>>, Vec<f64>, Vec<f64>), StabilityError> {
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::linalg::evd::{self, ComputeEigenvectors};
     use faer::{Mat, Par};
-    let mut d = vec![1.0; n];
-    eigen::balance_flat(&mut rows, n, &mut d);
     let b = Mat::<f64>::from_fn(n, n, |i, j| rows[i * n + j]);
-    drop(rows);
-    let mut u = Mat::<f64>::zeros(n, n);
+    let mut u = vectors.then(|| Mat::<f64>::zeros(n, n));
     let mut s_re = faer::diag::Diag::<f64>::zeros(n);
     let mut s_im = faer::diag::Diag::<f64>::zeros(n);
     let par = Par::Seq;
-    let scratch = evd::evd_scratch::<f64>(
-        n,
-        ComputeEigenvectors::No,
-        ComputeEigenvectors::Yes,
-        par,
-        Default::default(),
-    );
+    let want = if vectors {
+        ComputeEigenvectors::Yes
+    } else {
+        ComputeEigenvectors::No
+    };
+    let scratch =
+        evd::evd_scratch::<f64>(n, ComputeEigenvectors::No, want, par, Default::default());
     evd::evd_real(
         b.as_ref(),
         s_re.as_mut(),
         s_im.as_mut(),
         None,
-        Some(u.as_mut()),
+        u.as_mut().map(|u| u.as_mut()),
         par,
         MemStack::new(&mut MemBuffer::new(scratch)),
         Default::default(),
     )
     .map_err(|_| StabilityError::NoConvergence)?;
+    let re = (0..n).map(|j| s_re[j]).collect();
+    let im = (0..n).map(|j| s_im[j]).collect();
+    Ok((u, re, im))
+}
+
+/// The faer path of [`eigenpairs`] for `n > SMALL_MAX`.
+fn large_eigenpairs(mut rows: Vec<f64>, n: usize) -> Result<Vec<EigenPair>, StabilityError> {
+    let mut d = vec![1.0; n];
+    eigen::balance_flat(&mut rows, n, &mut d);
+    let (u, s_re, s_im) = faer_evd(&rows, n, true)?;
+    drop(rows);
+    let u = u.expect("eigenvectors were asked for");
     let mut out = Vec::with_capacity(n);
     let mut j = 0;
     while j < n {
@@ -289,18 +329,25 @@ pub fn mode_shape(mode: &Eigen) -> Vec<Complex<f64>> {
 }
 
 /// Amplitude and phase (degrees, `(−180, 180]`) of each entry of a
-/// [`mode_shape`].
+/// [`mode_shape`]. An entry with amplitude below [`PHASE_FLOOR`] is zero to
+/// working precision: its phase would be round-off and is reported as 0.
 pub fn amplitude_phase(shape: &[Complex<f64>]) -> Vec<(f64, f64)> {
     shape
         .iter()
         .map(|c| {
-            let phase = if c.norm() > 0.0 {
+            let amp = c.norm();
+            let phase = if amp > PHASE_FLOOR {
                 c.arg().to_degrees()
             } else {
                 0.0
             };
             // arg ∈ [−π, π]: fold −180 onto +180.
-            (c.norm(), if phase <= -180.0 { 180.0 } else { phase })
+            (amp, if phase <= -180.0 { 180.0 } else { phase })
         })
         .collect()
 }
+
+/// Relative amplitude (to the reference entry, 1) below which a mode-shape
+/// entry's phase is not reported ([`amplitude_phase`]): ≈ 5000 ε, the
+/// round-off of an eigenvector component that is exactly zero.
+pub const PHASE_FLOOR: f64 = 1e-12;

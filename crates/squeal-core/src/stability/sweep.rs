@@ -246,15 +246,22 @@ fn match_branches(
     let mut cost = vec![0.0; n * n];
     let mut macs = vec![0.0; n * n];
     let mut order: Vec<usize> = (0..n).collect();
+    let mut d = vec![0.0; n];
+    let k = CANDIDATES.min(n);
     for b in 0..n {
         for j in 0..n {
-            cost[b * n + j] = 1.0 + dist(b, j);
+            d[j] = dist(b, j);
+            cost[b * n + j] = 1.0 + d[j];
         }
-        order.sort_by(|&i, &j| dist(b, i).total_cmp(&dist(b, j)).then(i.cmp(&j)));
-        for &j in order.iter().take(CANDIDATES) {
+        // The k nearest (ties by index: deterministic), in O(n).
+        order.iter_mut().enumerate().for_each(|(i, o)| *o = i);
+        if k < n {
+            order.select_nth_unstable_by(k - 1, |&i, &j| d[i].total_cmp(&d[j]).then(i.cmp(&j)));
+        }
+        for &j in &order[..k] {
             let m = mac(shape(&prev[b].1), shape(&new[j].1));
             macs[b * n + j] = m;
-            cost[b * n + j] = (1.0 - m) + dist(b, j);
+            cost[b * n + j] = (1.0 - m) + d[j];
         }
     }
     let assign = hungarian(&cost, n);

@@ -10,3 +10,4 @@ pub mod reproduce;
 pub mod scenario;
 pub mod simulate;
 pub mod stability;
+pub mod sweep;

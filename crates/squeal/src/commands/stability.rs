@@ -1,6 +1,8 @@
-//! `squeal stability [SCENARIO] [--set …] [--json]`: every eigenvalue of the
-//! steady-sliding state, each mode's growth rate, frequency, damping ratio and
-//! dominant coordinate, and the verdict (MODEL.md §5).
+//! `squeal stability [SCENARIO] [--set …] [--json] [--out DIR]`: every
+//! eigenvalue of the steady-sliding state, each mode's growth rate,
+//! frequency, damping ratio, dominant coordinate and complex mode shape
+//! (amplitude and phase per dof; in `--json` and in `DIR/modes.csv`), and the
+//! verdict (MODEL.md §5).
 
 use crate::commands::simulate::resolve;
 use crate::model::AnyModel;
@@ -19,6 +21,54 @@ pub struct StabilityArgs {
     /// Print a JSON document on stdout instead of the table.
     #[arg(long)]
     json: bool,
+    /// Write modes.csv (complex mode shapes of every mode) into this folder.
+    #[arg(long)]
+    out: Option<std::path::PathBuf>,
+}
+
+/// How mode shapes are normalised (stated in the JSON and the README).
+pub const SHAPE_NORMALISATION: &str = "position part of the eigenvector divided by its largest component: that dof has amplitude 1 and phase 0, every amplitude is in [0, 1], phases in degrees in (-180, 180]";
+
+/// Amplitude and phase (degrees) of every position dof of a mode.
+fn shape_of(e: &squeal_core::stability::Eigen) -> Vec<(f64, f64)> {
+    use squeal_core::stability::modal::{amplitude_phase, mode_shape};
+    amplitude_phase(&mode_shape(e))
+}
+
+/// Write `modes.csv`: one row per mode and position dof,
+/// `mode,growth_rate,freq_hz,damping_ratio,dof,amplitude,phase_deg`, modes
+/// numbered as in the table (by growth rate).
+pub fn write_modes_csv(
+    path: &std::path::Path,
+    model: &AnyModel,
+    an: &Analysis,
+) -> Result<(), RunError> {
+    use std::io::Write;
+    let io = |e: std::io::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    writeln!(
+        w,
+        "mode,growth_rate,freq_hz,damping_ratio,dof,amplitude,phase_deg"
+    )
+    .map_err(io)?;
+    let names = model.state_names();
+    for (k, e) in an.eigen.iter().enumerate() {
+        for (i, (amp, ph)) in shape_of(e).into_iter().enumerate() {
+            writeln!(
+                w,
+                "{},{:e},{:e},{:e},{},{:e},{:e}",
+                k + 1,
+                e.re,
+                e.freq_hz,
+                e.damping_ratio,
+                names.get(i).map_or("", String::as_str),
+                amp,
+                ph
+            )
+            .map_err(io)?;
+        }
+    }
+    w.flush().map_err(io)
 }
 
 /// A stability failure as a command error: no steady sliding or bad
@@ -39,17 +89,23 @@ pub fn analyse(model: &AnyModel) -> Result<Analysis, StabilityError> {
 
 /// The JSON document of an analysis.
 pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
+    let names = model.state_names();
     let eig: Vec<Value> = an
         .eigen
         .iter()
         .map(|e| {
+            let shape: Vec<Value> = shape_of(e)
+                .into_iter()
+                .enumerate()
+                .map(|(i, (a, p))| json!({ "dof": names.get(i).map_or("", String::as_str), "amplitude": a, "phase_deg": p }))
+                .collect();
             json!({
                 "re": e.re, "im": e.im, "freq_hz": e.freq_hz,
                 "damping_ratio": e.damping_ratio, "dominant": e.dominant_name, "growing": e.growing,
+                "shape": shape,
             })
         })
         .collect();
-    let names = model.state_names();
     let eq: serde_json::Map<String, Value> = names
         .iter()
         .zip(&an.equilibrium)
@@ -62,6 +118,7 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
         "stable": an.stable,
         "least_stable": { "re": ls.re, "im": ls.im, "freq_hz": ls.freq_hz, "dominant": ls.dominant_name },
         "equilibrium": eq,
+        "shape_normalisation": SHAPE_NORMALISATION,
     })
 }
 
@@ -129,7 +186,15 @@ pub fn levers(model: &AnyModel) -> Vec<Lever> {
 /// Run the command.
 pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
+    if let Some(dest) = &a.out {
+        crate::run::check_dest(dest)?;
+    }
     let an = analyse(&sc.model).map_err(stability_error)?;
+    if let Some(dest) = &a.out {
+        let stage = crate::run::Staging::new(dest)?;
+        write_modes_csv(&stage.path("modes.csv"), &sc.model, &an)?;
+        stage.commit()?;
+    }
     // Levers need hundreds of analyses: only for models of the fixed-size path.
     let large = matches!(&sc.model, AnyModel::Lumped(l)
         if l.dof_count() > squeal_core::model::lumped::MAX_SIM_DOFS);
