@@ -188,3 +188,107 @@ fn disc_pad_monodromy_two_ways_default() {
 fn disc_pad_monodromy_two_ways_n2000() {
     disc_pad_saltation_vs_finite_differences(2000.0);
 }
+
+/// The van der Pol oscillator `ẍ − ε(1 − x²)ẋ + x = 0`: a smooth limit cycle
+/// with no events (one mode, no guards).
+struct VanDerPol(f64);
+
+impl squeal_core::Model<2> for VanDerPol {
+    fn name(&self) -> &'static str {
+        "van-der-pol"
+    }
+    fn state_names(&self) -> [&'static str; 2] {
+        ["x", "v"]
+    }
+    fn rhs(&self, _t: f64, _m: squeal_core::Mode, z: &[f64; 2], dz: &mut [f64; 2]) {
+        dz[0] = z[1];
+        dz[1] = self.0 * (1.0 - z[0] * z[0]) * z[1] - z[0];
+    }
+    fn guards(&self, _m: squeal_core::Mode, out: &mut squeal_core::model::Guards<2>) {
+        out.clear();
+    }
+    fn transition(
+        &self,
+        _t: f64,
+        mode: squeal_core::Mode,
+        _g: squeal_core::model::GuardKind,
+        _z: &mut [f64; 2],
+    ) -> (squeal_core::Mode, Option<EventKind>) {
+        (mode, None)
+    }
+    fn initial_mode(&self, _t: f64, _z: &[f64; 2]) -> squeal_core::Mode {
+        squeal_core::Mode::SlipPos
+    }
+    fn observe(
+        &self,
+        _t: f64,
+        _m: squeal_core::Mode,
+        _z: &[f64; 2],
+    ) -> squeal_core::model::Observables {
+        Default::default()
+    }
+    fn jacobian(&self, z: &[f64; 2]) -> [[f64; 2]; 2] {
+        [
+            [0.0, 1.0],
+            [
+                -1.0 - 2.0 * self.0 * z[0] * z[1],
+                self.0 * (1.0 - z[0] * z[0]),
+            ],
+        ]
+    }
+}
+
+#[test]
+fn smooth_van_der_pol_cycle_obeys_liouville() {
+    // Liouville: det M = exp(∮ tr J dt), and one multiplier is the trivial 1,
+    // so the other is exp(∮ ε(1 − x²) dt), integrated here independently by
+    // Simpson's rule on a fine uniform sampling of the simulated orbit.
+    for eps in [0.1, 1.0] {
+        let model = VanDerPol(eps);
+        let opts = tight(1e-12, 1e-12);
+        let cyc = find_cycle(&model, 0.0, [0.5, 0.0], &opts).unwrap();
+        assert_eq!(cyc.events_per_period.iter().sum::<u64>(), 0);
+        let k = 20_000;
+        let mut rec = squeal_core::sink::Recorder::<2>::new();
+        simulate(
+            &model,
+            0.0,
+            cyc.z0,
+            cyc.period,
+            k as f64 / cyc.period,
+            opts.solver,
+            &mut rec,
+        )
+        .unwrap();
+        assert_eq!(rec.t.len(), k + 1);
+        let h = cyc.period / k as f64;
+        let integral: f64 = (0..=k)
+            .map(|i| {
+                let w = if i == 0 || i == k {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * eps * (1.0 - rec.z[i][0] * rec.z[i][0])
+            })
+            .sum::<f64>()
+            * h
+            / 3.0;
+        let want = integral.exp();
+        let triv: Vec<_> = cyc.multipliers.iter().filter(|m| m.trivial).collect();
+        assert_eq!(triv.len(), 1);
+        assert!((triv[0].re - 1.0).abs() <= 1e-8, "{:?}", cyc.multipliers);
+        let other = cyc.multipliers.iter().find(|m| !m.trivial).unwrap();
+        assert!(other.im == 0.0);
+        assert!(
+            (other.re - want).abs() <= 1e-6 * want,
+            "ε = {eps}: {} vs exp(∮ tr J) = {want}",
+            other.re
+        );
+        // The orbit returns to itself (the limit cycle of amplitude ≈ 2).
+        assert!((rec.z[k][0] - cyc.z0[0]).abs() <= 1e-8);
+        assert!((cyc.amplitude[0] - 2.0).abs() <= 0.02);
+    }
+}
