@@ -153,6 +153,27 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
             bifurcations.push(json!({ "between": [w[0].value, w[1].value], "kind": what }));
         }
     }
+    // The linear picture: where steady sliding changes stability in the
+    // range (`critical`'s Hopf point), and the branch's point nearest to it.
+    let hopf = crate::commands::critical::locate(&sc.model, &name, lo, hi, 64)
+        .ok()
+        .flatten()
+        .map(|c| {
+            let near = points.iter().min_by(|p, q| {
+                (p.value - c.value)
+                    .abs()
+                    .total_cmp(&(q.value - c.value).abs())
+            });
+            json!({
+                "value": c.value,
+                "freq_hz": c.freq_hz,
+                "nearest_point": near.map(|p| json!({
+                    "value": p.value,
+                    "cycle_freq_hz": 1.0 / p.found.period,
+                    "max_multiplier": p.found.max_multiplier,
+                })),
+            })
+        });
     let stage = Staging::new(&a.out)?;
     write_csv(&name, &names, &points, &stage.path("branch.csv"))?;
     draw(&sc, &name, &points, &stage)?;
@@ -165,6 +186,7 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
         }).collect::<Vec<_>>(),
         "bifurcations": bifurcations,
         "failed": failures,
+        "hopf": hopf,
         "scenario": sc.to_json(),
     });
     crate::output::write_json(&doc, &stage.path("summary.json"))?;
@@ -187,6 +209,15 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
                 b["between"][0],
                 b["between"][1],
                 b["kind"].as_str().unwrap_or("")
+            );
+        }
+        if let Some(h) = &hopf {
+            println!(
+                "  steady sliding changes stability at {name} = {} ({:.3} Hz, `critical`); the nearest cycle, at {}, has {:.3} Hz",
+                h["value"],
+                h["freq_hz"].as_f64().unwrap_or(f64::NAN),
+                h["nearest_point"]["value"],
+                h["nearest_point"]["cycle_freq_hz"].as_f64().unwrap_or(f64::NAN)
             );
         }
         for f in &failures {
