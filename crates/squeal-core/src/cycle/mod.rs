@@ -310,6 +310,19 @@ fn saltation<S: System<N> + ?Sized, const N: usize>(
     &p + jump * g_s / rate
 }
 
+/// The time from which the model is autonomous (after its last breakpoint,
+/// e.g. the end of a load ramp): every period is integrated from there.
+fn autonomous_from<S: System<N> + ?Sized, const N: usize>(sys: &S) -> f64 {
+    let mut t = 0.0;
+    for _ in 0..1000 {
+        match sys.breakpoint_after(t) {
+            Some(b) if b > t => t = b,
+            _ => break,
+        }
+    }
+    t
+}
+
 /// Integrate one period `T` from `z0` with the variational equations.
 fn period_flow<S: System<N> + ?Sized, const N: usize>(
     sys: &S,
@@ -320,7 +333,8 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
     variational: bool,
     mut orbit: Option<&mut Orbit<N>>,
 ) -> Result<Period<N>, CycleError> {
-    let mut solver = Solver::new(sys, 0.0, *z0, period, opts.solver)?;
+    let t_a = autonomous_from(sys);
+    let mut solver = Solver::new(sys, t_a, *z0, t_a + period, opts.solver)?;
     let mut phi = DMatrix::<f64>::identity(N, N);
     let mut j1 = DMatrix::<f64>::zeros(N, N);
     let mut j2 = DMatrix::<f64>::zeros(N, N);
@@ -390,7 +404,7 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
             }
             if let Some(o) = orbit.as_deref_mut() {
                 if k < PTS || !seg.switched {
-                    o.t.push(t);
+                    o.t.push(t - t_a);
                     o.z.push(z);
                     o.modes.push(seg.modes);
                     o.event.push(None);
@@ -409,11 +423,11 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
                 events[ev.index()] += 1;
             }
             if let Some(o) = orbit.as_deref_mut() {
-                o.t.push(seg.t1);
+                o.t.push(seg.t1 - t_a);
                 o.z.push(z_m);
                 o.modes.push(seg.modes);
                 o.event.push(None);
-                o.t.push(seg.t1);
+                o.t.push(seg.t1 - t_a);
                 o.z.push(z_p);
                 o.modes.push(modes_p);
                 o.event.push(seg.event.map(|e| (e, seg.contact)));
@@ -623,6 +637,57 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
     z0: [f64; N],
     opts: &CycleOptions,
 ) -> Result<Cycle<N>, CycleError> {
+    // What the motion settles on is stable: an unstable periodic orbit met
+    // on the way (the brake's normal vibration while the pad's mode still
+    // grows, say) is left by simulating on until its instability has grown
+    // a thousandfold, then settling again (at most four times).
+    let (mut t, mut z) = (t0, z0);
+    let mut spent = 0.0;
+    let mut attempt = 0;
+    let mut local = *opts;
+    loop {
+        // Shooting that fails from a settled state (a slowly changing
+        // motion that only looked periodic) settles longer, to a tighter match.
+        let (c, settled) = match settle_and_shoot(sys, t, z, &local) {
+            Err(CycleError::Shooting(_)) if attempt < 3 && local.settle_tol > 1e-6 => {
+                attempt += 1;
+                local.settle_tol *= 0.1;
+                continue;
+            }
+            other => other?,
+        };
+        spent += settled;
+        attempt += 1;
+        if c.stable || attempt >= 4 || c.max_multiplier <= 1.0 {
+            let mut c = c;
+            c.settle_time = spent;
+            return Ok(c);
+        }
+        let skip = c.period * (1e3f64.ln() / c.max_multiplier.ln()).min(1e6);
+        let t_here = t + settled;
+        let mut sopts = opts.solver;
+        sopts.rtol = sopts.rtol.max(opts.settle_rtol);
+        sopts.max_steps = opts.settle_steps;
+        let mut sol = Solver::new(sys, t_here, c.z0, t_here + skip, sopts)?;
+        while sol.step()?.is_some() {}
+        spent += skip;
+        t = sol.t();
+        z = *sol.state();
+        if spent >= opts.settle_time {
+            let mut c = c;
+            c.settle_time = spent;
+            return Ok(c);
+        }
+    }
+}
+
+/// One settling run from `(t0, z0)` and the shooting that follows it.
+fn settle_and_shoot<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    t0: f64,
+    z0: [f64; N],
+    opts: &CycleOptions,
+) -> Result<(Cycle<N>, f64), CycleError> {
     // A settling run at the looser settle_rtol that fails (chatter the
     // tighter tolerance resolves, say) is repeated at the solver's own.
     let (section, z, period, settled) = match settle(sys, t0, z0, opts) {
@@ -633,9 +698,8 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
         }
         other => other?,
     };
-    let mut c = shoot(sys, z, period, section, opts)?;
-    c.settle_time = settled;
-    Ok(c)
+    let c = shoot(sys, z, period, section, opts)?;
+    Ok((c, settled))
 }
 
 /// Newton shooting from a guess `(z0, period)` on `section`, then the multipliers.
@@ -684,8 +748,9 @@ pub fn shoot<S: System<N> + ?Sized, const N: usize>(
         }
         iterations += 1;
         let mut f = [0.0; N];
-        let modes = sys.start_modes(t, &p.z_end);
-        sys.field(t, &modes, &p.z_end, &mut f);
+        let t_end = autonomous_from(sys) + t;
+        let modes = sys.start_modes(t_end, &p.z_end);
+        sys.field(t_end, &modes, &p.z_end, &mut f);
         let mut a = DMatrix::<f64>::zeros(N + 1, N + 1);
         let mut b = nalgebra::DVector::<f64>::zeros(N + 1);
         for i in 0..N {
@@ -729,8 +794,9 @@ fn finish<S: System<N> + ?Sized, const N: usize>(
     p: Period<N>,
 ) -> Result<Cycle<N>, CycleError> {
     let mut f = [0.0; N];
-    let modes = sys.start_modes(0.0, &z);
-    sys.field(0.0, &modes, &z, &mut f);
+    let t_a = autonomous_from(sys);
+    let modes = sys.start_modes(t_a, &z);
+    sys.field(t_a, &modes, &z, &mut f);
     let fs = nalgebra::DVector::from_fn(N, |i, _| f[i] / s[i]);
     let k = section.index;
     let (multipliers, max_multiplier) = multipliers_of(&p.m, &fs, k);
@@ -848,7 +914,8 @@ pub fn finite_difference_monodromy<S: System<N> + ?Sized, const N: usize>(
 ) -> Result<[[f64; N]; N], CycleError> {
     let s = block_scales(&cycle.amplitude, &solver);
     let end = |z: [f64; N]| -> Result<[f64; N], CycleError> {
-        let mut sol = Solver::new(sys, 0.0, z, cycle.period, solver)?;
+        let t_a = autonomous_from(sys);
+        let mut sol = Solver::new(sys, t_a, z, t_a + cycle.period, solver)?;
         while sol.step()?.is_some() {}
         Ok(*sol.state())
     };
