@@ -60,7 +60,7 @@ const THESIS_PARAMS: &[ParamSpec] = &[
         "f0",
         "1",
         "friction coefficient at zero sliding speed (= μ_s)",
-        ParamKind::Positive,
+        ParamKind::NonNegative,
     ),
     ParamSpec::new(
         "f1",
@@ -80,7 +80,7 @@ const COULOMB_PARAMS: &[ParamSpec] = &[
         "mu_s",
         "1",
         "static friction coefficient",
-        ParamKind::Positive,
+        ParamKind::NonNegative,
     ),
     ParamSpec::new(
         "mu_k",
@@ -94,7 +94,7 @@ const STRIBECK_PARAMS: &[ParamSpec] = &[
         "mu_s",
         "1",
         "static friction coefficient",
-        ParamKind::Positive,
+        ParamKind::NonNegative,
     ),
     ParamSpec::new(
         "mu_k",
@@ -121,7 +121,7 @@ const RATIONAL_PARAMS: &[ParamSpec] = &[
         "mu_s",
         "1",
         "static friction coefficient",
-        ParamKind::Positive,
+        ParamKind::NonNegative,
     ),
     ParamSpec::new(
         "delta",

@@ -207,6 +207,16 @@ impl<'a> Prepared<'a> {
             Some((lo, hi)) => axis_range(lo, hi, false, 0.05),
             None => ((0.0, 1.0), false),
         };
+        // Spans beyond the largest float (1.7e308 against −1.7e308) or
+        // near it leave nothing to draw: an error, not an endless tick search.
+        for (axis, (a, b)) in [("x", x_range), ("y", y_range)] {
+            if !(b - a).is_finite() || a.abs() > 1e300 || b.abs() > 1e300 {
+                return Err(PlotError::Input(format!(
+                    "panel \"{}\": {axis} values from {a:e} to {b:e} are too large to draw",
+                    p.title
+                )));
+            }
+        }
         match yr {
             None => {
                 note = Some(if p.series.iter().all(|s| s.x.is_empty()) {

@@ -6,11 +6,16 @@
 
 mod analysis;
 mod commands;
+mod feasible;
 mod lumped_file;
 mod model;
+mod out;
 mod output;
 mod run;
 mod scenario;
+#[cfg(test)]
+mod scenario_props;
+mod staging;
 
 use clap::{Args, Parser, Subcommand};
 use run::RunError;
@@ -65,7 +70,11 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    staging::install_signal_handlers();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return usage_error(e),
+    };
     let result = match cli.command {
         Command::Simulate(a) => commands::simulate::run(a),
         Command::Scenario { what } => commands::scenario::run(what),
@@ -89,4 +98,36 @@ fn main() -> ExitCode {
             }
         }
     }
+}
+
+/// A command-line error in one line (clap's first line, and its tip if it
+/// has one) and exit code 2; help and version print in full, exit code 0.
+fn usage_error(e: clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    if matches!(
+        e.kind(),
+        ErrorKind::DisplayHelp
+            | ErrorKind::DisplayVersion
+            | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) {
+        if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+            eprint!("{}", e.render());
+            return ExitCode::from(2);
+        }
+        out::text(&e.render().to_string());
+        return ExitCode::SUCCESS;
+    }
+    let text = e.render().to_string();
+    let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
+    let first = lines.next().unwrap_or("error: bad command line");
+    let first = if first.starts_with("error:") {
+        first.to_string()
+    } else {
+        format!("error: {first}")
+    };
+    match lines.find(|l| l.starts_with("tip:")) {
+        Some(tip) => eprintln!("{first} ({tip}; see --help)"),
+        None => eprintln!("{first} (see --help)"),
+    }
+    ExitCode::from(2)
 }

@@ -6,6 +6,9 @@ use squeal_core::EventKind;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
+/// Largest series file `read_run_dir` reads (4 GB).
+pub const MAX_SERIES_FILE: u64 = 4_000_000_000;
+
 fn io_err(path: &Path, e: std::io::Error) -> RunError {
     RunError::Io(format!("cannot write {}: {e}", path.display()))
 }
@@ -132,6 +135,54 @@ pub fn write_json(value: &Value, path: &Path) -> Result<(), RunError> {
     std::fs::write(path, text).map_err(|e| io_err(path, e))
 }
 
+/// A run folder's series must be something a run can have written: at
+/// least one sample, every value finite, the time column `t` first and
+/// strictly increasing. Anything else is refused naming the sample (row 1
+/// is the first after the header) and the column.
+fn check_series(dir: &Path, columns: &[String], data: &[Vec<f64>]) -> Result<(), RunError> {
+    let bad = |msg: String| {
+        RunError::Input(crate::scenario::InputError(format!(
+            "run folder {}: {msg}",
+            dir.display()
+        )))
+    };
+    let rows = data.first().map_or(0, Vec::len);
+    if columns.first().map(String::as_str) != Some("t") {
+        return Err(bad("the series' first column is not t".into()));
+    }
+    if rows == 0 {
+        return Err(bad(
+            "the series has no samples (only a header): nothing to draw or play; run simulate again".into(),
+        ));
+    }
+    if let Some(c) = data.iter().position(|col| col.len() != rows) {
+        return Err(bad(format!(
+            "column {} has {} values, t has {rows}",
+            columns[c],
+            data[c].len()
+        )));
+    }
+    for (c, col) in data.iter().enumerate() {
+        if let Some(r) = col.iter().position(|v| !v.is_finite()) {
+            return Err(bad(format!(
+                "sample {}, column {}: {} is not a finite number",
+                r + 1,
+                columns[c],
+                col[r]
+            )));
+        }
+    }
+    if let Some(r) = data[0].windows(2).position(|w| w[1] <= w[0]) {
+        return Err(bad(format!(
+            "sample {}: time t = {:e} does not come after {:e} (t must increase)",
+            r + 2,
+            data[0][r + 1],
+            data[0][r]
+        )));
+    }
+    Ok(())
+}
+
 /// Read a run folder written by `squeal simulate` back: its columns (from
 /// `series.csv`, or `series.npy` with the names from `summary.json`) and
 /// its summary.
@@ -149,6 +200,20 @@ pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
         })?;
     let csv = dir.join("series.csv");
     let npy = dir.join("series.npy");
+    // Read whole: refuse what squeal could not have written (its series
+    // stay below 1 GiB in memory, ~3 GB as text) before reading it.
+    for p in [&csv, &npy] {
+        if let Ok(m) = std::fs::metadata(p) {
+            if m.len() > MAX_SERIES_FILE {
+                return Err(bad(format!(
+                    "{}: {:.2} GB is larger than any series squeal writes ({:.0} GB at most)",
+                    p.display(),
+                    m.len() as f64 / 1e9,
+                    MAX_SERIES_FILE as f64 / 1e9
+                )));
+            }
+        }
+    }
     let (columns, data) = if csv.is_file() {
         let text = std::fs::read_to_string(&csv)
             .map_err(|e| bad(format!("{}: cannot read: {e}", csv.display())))?;
@@ -214,8 +279,9 @@ pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
             dir.display()
         )));
     };
+    check_series(dir, &columns, &data)?;
     let sample_rate = summary["scenario"]["sample_rate"].as_f64().unwrap_or(0.0);
-    if sample_rate.is_nan() || sample_rate <= 0.0 {
+    if !(sample_rate.is_finite() && sample_rate > 0.0) {
         return Err(bad(format!(
             "{}: no scenario.sample_rate",
             summary_path.display()

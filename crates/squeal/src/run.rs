@@ -1,5 +1,5 @@
-//! Running a scenario: integrate, collect columns, and stage outputs in a
-//! temporary folder that is renamed into place only when complete.
+//! Running a scenario: integrate and collect columns and events (outputs
+//! are staged by [`crate::staging::Staging`], re-exported here).
 
 use crate::model::observe_all;
 use crate::model::AnyModel;
@@ -10,7 +10,8 @@ use squeal_core::integrate::{Flow, Sink};
 use squeal_core::model::{Modes, Observables};
 use squeal_core::{simulate, EventKind, Mode, RunInfo, System};
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+
+pub use crate::staging::Staging;
 use std::time::Instant;
 
 /// Why a run failed: bad input (exit code 2) or trouble during the run (exit code 1).
@@ -179,7 +180,7 @@ fn run_model<M: System<N> + ?Sized, const N: usize>(
         sc.solver,
         &mut sink,
     )
-    .map_err(|e| RunError::Numerical(e.to_string()))?;
+    .map_err(|e| RunError::Numerical(explain(e, sc.duration)))?;
     let integrate_s = start.elapsed().as_secs_f64();
     progress.finish_and_clear();
     Ok(Run {
@@ -196,6 +197,20 @@ fn run_model<M: System<N> + ?Sized, const N: usize>(
     })
 }
 
+/// An integration failure in words; an exhausted step budget says why the
+/// run could be that expensive.
+pub fn explain(e: squeal_core::IntegrateError, duration: f64) -> String {
+    match e {
+        squeal_core::IntegrateError::MaxSteps { t, steps } => format!(
+            "work budget exhausted at t = {t:.9e} s of {duration} s: {steps} steps (mean step {:.3e} s), \
+             far more than the fastest mode of steady sliding needs: the run became stiff (a steep \
+             friction law near v_rel = 0, chatter, or contact): check extreme parameter values, or loosen rtol/atol",
+            t / steps.max(1) as f64
+        ),
+        other => other.to_string(),
+    }
+}
+
 /// Integrate a scenario, with a progress bar on a terminal.
 pub fn run(sc: &Scenario) -> Result<Run, RunError> {
     let pb = progress_bar(1000, &format!("simulating {}", sc.name));
@@ -206,116 +221,4 @@ pub fn run(sc: &Scenario) -> Result<Run, RunError> {
 pub fn run_with(sc: &Scenario, pb: &ProgressBar) -> Result<Run, RunError> {
     crate::with_system!(&sc.model, m => run_model(m, &sc.model, sc, pb),
         else => Err(RunError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))))
-}
-
-/// An output folder written under a temporary name and renamed into place
-/// by [`Staging::commit`]; dropped uncommitted, it is removed.
-pub struct Staging {
-    tmp: PathBuf,
-    dest: PathBuf,
-    done: bool,
-}
-
-/// Files by which an existing folder is recognised as squeal's own output.
-const MARKERS: [&str; 6] = [
-    "summary.json",
-    "map.csv",
-    "report.md",
-    "conclusions.json",
-    "sweep.csv",
-    "modes.csv",
-];
-
-/// Check, before any work, that `dest` may be written: it does not exist, or
-/// it is an empty folder, or a folder squeal wrote before (which is replaced).
-/// Anything else — a file, the current folder, a folder of the user's — is
-/// refused rather than replaced.
-pub fn check_dest(dest: &Path) -> Result<(), RunError> {
-    let refuse =
-        |why: &str| RunError::Input(InputError(format!("--out {}: {why}", dest.display())));
-    if dest.file_name().is_none() {
-        return Err(refuse(
-            "name a folder of its own (squeal replaces it whole)",
-        ));
-    }
-    if !dest.exists() {
-        return Ok(());
-    }
-    if !dest.is_dir() {
-        return Err(refuse("exists and is not a folder"));
-    }
-    let mut entries =
-        std::fs::read_dir(dest).map_err(|e| refuse(&format!("cannot read it: {e}")))?;
-    let empty = entries.next().is_none();
-    if empty || MARKERS.iter().any(|m| dest.join(m).is_file()) {
-        Ok(())
-    } else {
-        Err(refuse(
-            "exists and is not a squeal output folder; refusing to replace it",
-        ))
-    }
-}
-
-impl Staging {
-    /// Stage output for `dest` (checked by [`check_dest`]).
-    pub fn new(dest: &Path) -> Result<Staging, RunError> {
-        check_dest(dest)?;
-        let io = |e: std::io::Error, p: &Path| {
-            RunError::Io(format!("cannot create {}: {e}", p.display()))
-        };
-        let parent = dest
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        std::fs::create_dir_all(parent).map_err(|e| io(e, parent))?;
-        let name = dest
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "out".into());
-        let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
-        if tmp.exists() {
-            let _ = std::fs::remove_dir_all(&tmp);
-        }
-        std::fs::create_dir_all(&tmp).map_err(|e| io(e, &tmp))?;
-        Ok(Staging {
-            tmp,
-            dest: dest.to_path_buf(),
-            done: false,
-        })
-    }
-    /// Path of a file inside the staging folder.
-    pub fn path(&self, file: &str) -> PathBuf {
-        self.tmp.join(file)
-    }
-    /// The staging folder.
-    pub fn dir(&self) -> &Path {
-        &self.tmp
-    }
-    /// Move the complete output into place (replacing an older one).
-    pub fn commit(mut self) -> Result<PathBuf, RunError> {
-        let io = |e: std::io::Error| {
-            RunError::Io(format!(
-                "cannot move output into {}: {e}",
-                self.dest.display()
-            ))
-        };
-        if self.dest.exists() {
-            let old = self.tmp.with_extension("old");
-            std::fs::rename(&self.dest, &old).map_err(io)?;
-            std::fs::rename(&self.tmp, &self.dest).map_err(io)?;
-            let _ = std::fs::remove_dir_all(&old);
-        } else {
-            std::fs::rename(&self.tmp, &self.dest).map_err(io)?;
-        }
-        self.done = true;
-        Ok(self.dest.clone())
-    }
-}
-
-impl Drop for Staging {
-    fn drop(&mut self) {
-        if !self.done {
-            let _ = std::fs::remove_dir_all(&self.tmp);
-        }
-    }
 }

@@ -24,6 +24,9 @@ fn err<T>(msg: impl Into<String>) -> Result<T, InputError> {
     Err(InputError(msg.into()))
 }
 
+/// Largest scenario file read (1 MiB).
+pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
+
 /// Most samples a run may write (guards memory against a typo in `sample_rate`).
 pub const MAX_SAMPLES: f64 = 5.0e7;
 
@@ -216,8 +219,24 @@ impl Scenario {
     pub fn load(spec: &str) -> Result<Scenario, InputError> {
         let path = Path::new(spec);
         if path.is_file() || spec.ends_with(".toml") {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| InputError(format!("scenario file {spec}: cannot read: {e}")))?;
+            // A scenario is a few kB; reading stops at 1 MiB (a device or a
+            // wrong file is not read for ever).
+            let mut text = String::new();
+            std::io::Read::read_to_string(
+                &mut std::io::Read::take(
+                    std::fs::File::open(path).map_err(|e| {
+                        InputError(format!("scenario file {spec}: cannot read: {e}"))
+                    })?,
+                    MAX_SCENARIO_BYTES + 1,
+                ),
+                &mut text,
+            )
+            .map_err(|e| InputError(format!("scenario file {spec}: cannot read: {e}")))?;
+            if text.len() as u64 > MAX_SCENARIO_BYTES {
+                return err(format!(
+                    "scenario file {spec}: larger than 1 MiB; not a scenario"
+                ));
+            }
             let mut sc = Scenario::from_toml_in(&text, path.parent())
                 .map_err(|e| InputError(format!("{spec}: {}", e.0)))?;
             // A file without a `name` is named after itself (out/<file stem>).
@@ -227,6 +246,8 @@ impl Scenario {
             if !named {
                 if let Some(stem) = path.file_stem() {
                     sc.name = stem.to_string_lossy().into_owned();
+                    check_name(&sc.name)
+                        .map_err(|e| InputError(format!("{spec}: no `name` key, and {}", e.0)))?;
                 }
             }
             return Ok(sc);
@@ -310,7 +331,10 @@ impl Scenario {
                         "{key}: a lumped model takes its parameters in its elements ([[spring]], [[contact]], …)"
                     ))
                 }
-                ("name", toml::Value::String(v)) => s.name = v.clone(),
+                ("name", toml::Value::String(v)) => {
+                    check_name(v)?;
+                    s.name = v.clone();
+                }
                 ("description", toml::Value::String(v)) => s.description = v.clone(),
                 ("params" | "friction" | "offsets" | "solver", toml::Value::Table(t)) => {
                     for (k, v) in t {
@@ -344,10 +368,11 @@ impl Scenario {
     /// Apply `--set KEY=VALUE` overrides: friction-law switches first, then
     /// the rest in order; then validate.
     pub fn apply_overrides(&mut self, sets: &[String]) -> Result<(), InputError> {
+        check_set_syntax(sets, "")?;
         let mut parsed = Vec::new();
         for raw in sets {
             let Some((k, v)) = raw.split_once('=') else {
-                return err(format!("--set {raw}: expected NAME=VALUE"));
+                return err(format!("--set {raw}: --set needs NAME=VALUE"));
             };
             parsed.push((k.trim().to_string(), v.trim().to_string(), raw));
         }
@@ -386,13 +411,49 @@ impl Scenario {
                     ));
                 }
                 return err(format!(
-                    "unknown key '{key}' for model {} with the {} friction law",
+                    "unknown key '{key}' for model {} with the {} friction law; {}",
                     self.model.name(),
-                    self.model.friction().name()
+                    self.model.friction().name(),
+                    suggest(key, &self.known_keys())
                 ));
             }
         };
         self.apply_in(section, key, value)
+    }
+
+    /// Every key `--set` accepts for this scenario's model and friction law.
+    pub fn known_keys(&self) -> Vec<String> {
+        let mut keys: Vec<String> = self
+            .model
+            .param_specs()
+            .iter()
+            .chain(self.model.friction().params())
+            .filter(|p| self.model.get(p.name).is_some())
+            .map(|p| p.name.to_string())
+            .collect();
+        keys.extend(
+            [
+                "friction",
+                "initial",
+                "duration",
+                "sample_rate",
+                "name",
+                "description",
+                "rtol",
+                "atol_pos",
+                "atol_vel",
+                "h_max",
+            ]
+            .map(String::from),
+        );
+        if matches!(self.model, AnyModel::DiscPad(_)) {
+            keys.push("contact".into());
+        }
+        for n in self.model.state_names() {
+            keys.push(format!("{n}0"));
+            keys.push(format!("atol_{n}"));
+        }
+        keys
     }
 
     /// `atol_<state>`: a per-state absolute tolerance.
@@ -452,7 +513,11 @@ impl Scenario {
                     }
                 }
             }
-            ("", "name") => self.name = text(value)?,
+            ("", "name") => {
+                let name = text(value)?;
+                check_name(&name)?;
+                self.name = name;
+            }
             ("", "description") => self.description = text(value)?,
             ("", "duration") => {
                 let x = number(value)?;
@@ -533,10 +598,21 @@ impl Scenario {
                         || self.model.friction().get(k).is_some()
                 };
                 if !known {
+                    let mut keys: Vec<String> = self
+                        .model
+                        .friction()
+                        .params()
+                        .iter()
+                        .map(|p| p.name.to_string())
+                        .collect();
+                    if section == "params" {
+                        keys.extend(self.model.param_specs().iter().map(|p| p.name.to_string()));
+                    }
                     return err(format!(
-                        "unknown parameter '{shown}' for model {} with the {} friction law",
+                        "unknown parameter '{shown}' for model {} with the {} friction law; {}",
                         self.model.name(),
-                        self.model.friction().name()
+                        self.model.friction().name(),
+                        suggest(k, &keys)
                     ));
                 }
                 self.model
@@ -555,9 +631,13 @@ impl Scenario {
             .map_err(|e| InputError(e.to_string()))?;
         let samples = self.duration * self.sample_rate;
         if samples > MAX_SAMPLES {
+            let columns = 1 + self.model.state_names().len() + self.model.derived_columns().len();
             return err(format!(
-                "sample_rate = {}: {samples:.3e} samples over {} s exceed the limit of {MAX_SAMPLES:.0e}",
-                self.sample_rate, self.duration
+                "duration = {:e} s at sample_rate = {:e} Hz: {samples:.3e} samples ({:.3e} GB in memory) \
+                 exceed the limit of {MAX_SAMPLES:.0e} samples; lower duration or sample_rate",
+                self.duration,
+                self.sample_rate,
+                samples * columns as f64 * 8.0 / 1e9
             ));
         }
         Ok(())
@@ -637,10 +717,15 @@ impl Scenario {
         let _ = writeln!(t);
         line(
             &mut t,
-            format!("name = {:?}", self.name),
+            format!("name = {}", toml::Value::String(self.name.clone())),
             "default output folder: out/<name>",
         );
-        let _ = writeln!(t, "description = {:?}", self.description);
+        // TOML's own escaping: Rust's `{:?}` writes `\u{7}`, which TOML cannot read.
+        let _ = writeln!(
+            t,
+            "description = {}",
+            toml::Value::String(self.description.clone())
+        );
         line(
             &mut t,
             format!("model = {:?}", self.model.name()),
@@ -762,6 +847,88 @@ impl Scenario {
                 "# h_max = 1e-6                    # s, largest step (default: unlimited)"
             );
         }
+    }
+}
+
+/// Longest scenario name (the output folder `out/<name>-map` must stay a
+/// legal file name).
+pub const MAX_NAME_BYTES: usize = 200;
+
+/// A scenario's `name` names its output folder `out/<name>`: it must be a
+/// plain name, not a path — not empty, no `/` or `\`, no control
+/// characters, not starting with `.` (so neither `.`, `..` nor a hidden
+/// folder), at most [`MAX_NAME_BYTES`] bytes.
+pub fn check_name(name: &str) -> Result<(), InputError> {
+    let why = if name.is_empty() {
+        Some("is empty")
+    } else if name.contains(['/', '\\']) {
+        Some("is a path; give a plain name (it names the folder out/<name>)")
+    } else if name.starts_with('.') {
+        Some("must not start with '.' (it names the folder out/<name>)")
+    } else if name.chars().any(char::is_control) {
+        Some("contains a control character")
+    } else if name.len() > MAX_NAME_BYTES {
+        Some("is longer than 200 bytes")
+    } else {
+        None
+    };
+    match why {
+        Some(why) => err(format!("name = {name:?}: {why}")),
+        None => Ok(()),
+    }
+}
+
+/// Every `--set` must be `NAME=VALUE`. `--set V 2` (a space for the `=`)
+/// makes `2` the scenario: say what was meant. `scenario` is the scenario
+/// argument as given ("" if unknown).
+pub fn check_set_syntax(sets: &[String], scenario: &str) -> Result<(), InputError> {
+    let Some(raw) = sets.iter().find(|s| !s.contains('=')) else {
+        return Ok(());
+    };
+    let loose = !scenario.is_empty()
+        && !Path::new(scenario).exists()
+        && Scenario::builtin(scenario).is_none();
+    let hint = if loose {
+        format!("; did you mean --set {raw}={scenario}?")
+    } else {
+        format!("; e.g. --set {}=VALUE", raw.trim())
+    };
+    err(format!("--set {raw}: --set needs NAME=VALUE{hint}"))
+}
+
+/// Levenshtein distance (for suggestions).
+fn distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+/// "did you mean N?" for a near key (same letters in another case, or one
+/// or two edits away), else the list of valid keys.
+pub fn suggest(key: &str, keys: &[String]) -> String {
+    let near = keys
+        .iter()
+        .map(|k| {
+            let d = if k.eq_ignore_ascii_case(key) {
+                0
+            } else {
+                distance(&k.to_lowercase(), &key.to_lowercase()) + 1
+            };
+            (d, k)
+        })
+        .min();
+    match near {
+        Some((d, k)) if d <= 2 || (d <= 3 && key.len() > 4) => format!("did you mean '{k}'?"),
+        _ => format!("valid keys: {}", keys.join(", ")),
     }
 }
 

@@ -13,6 +13,7 @@
 //! [`Solver`] is the manual-stepping API; [`simulate`] is a thin loop over it
 //! that feeds uniformly sampled states and events into a [`Sink`].
 
+pub mod budget;
 pub mod roots;
 mod tableau;
 

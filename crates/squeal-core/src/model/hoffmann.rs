@@ -118,7 +118,7 @@ const SPECS: &[ParamSpec] = &[
         "mu",
         "1",
         "friction coefficient (coulomb law: sets mu_s = mu_k)",
-        ParamKind::Positive,
+        ParamKind::NonNegative,
     ),
     ParamSpec::new("V", "m/s", "belt speed", ParamKind::NonNegative),
     ParamSpec::new("N0", "N", "preload normal force", ParamKind::NonNegative),

@@ -78,7 +78,10 @@ pub fn balance_flat(a: &mut [f64], n: usize, d: &mut [f64]) {
                     r += a[i * n + j].abs();
                 }
             }
-            if c == 0.0 || r == 0.0 {
+            // A zero row or column needs no scaling; a non-finite sum (an
+            // infinite or NaN entry, or 1-norms that overflow) cannot be
+            // balanced: the scaling loops below would never end on it.
+            if c == 0.0 || r == 0.0 || !(c + r).is_finite() {
                 continue;
             }
             let s = c + r;

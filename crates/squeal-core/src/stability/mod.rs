@@ -58,7 +58,7 @@ pub enum StabilityError {
     /// The equilibrium or the Jacobian there has NaN or infinite entries.
     #[error("the {what} at steady sliding is not finite")]
     NonFinite {
-        /// `equilibrium` or `Jacobian`.
+        /// `equilibrium`, `Jacobian` or `spectrum (eigenvalues)`.
         what: &'static str,
     },
     /// The QR iteration needed more than `eigen::MAX_QR_ITERATIONS` steps
@@ -214,6 +214,18 @@ pub fn state_matrix<M: System<N> + ?Sized, const N: usize>(
     Ok((z, a))
 }
 
+/// A state matrix with finite entries can still have eigenvalues that
+/// overflow (entries near 1e300): an error, like a non-finite matrix.
+pub(crate) fn check_finite(ev: &[Complex<f64>]) -> Result<(), StabilityError> {
+    if ev.iter().all(|e| e.re.is_finite() && e.im.is_finite()) {
+        Ok(())
+    } else {
+        Err(StabilityError::NonFinite {
+            what: "spectrum (eigenvalues)",
+        })
+    }
+}
+
 /// Full linear stability analysis of steady sliding (MODEL.md §5) with unit
 /// masses for the mode attribution (see [`Eigen::participation`]).
 ///
@@ -248,6 +260,7 @@ fn analyse_impl<M: System<N> + ?Sized, const N: usize>(
 ) -> Result<Analysis, StabilityError> {
     let (z, a) = state_matrix(model)?;
     let (ev, bal, d) = eigen::eigenvalues_balanced(&a).ok_or(StabilityError::NoConvergence)?;
+    check_finite(&ev)?;
     let names = model.names();
     // A real matrix's eigenvector of λ̄ is the conjugate of λ's: computed once per pair.
     let mut done: Vec<(Complex<f64>, Vec<Complex<f64>>)> = Vec::with_capacity(N);
@@ -285,6 +298,7 @@ pub fn max_growth_rate<M: System<N> + ?Sized, const N: usize>(
 ) -> Result<(f64, f64), StabilityError> {
     let (_, a) = state_matrix(model)?;
     let ev = eigen::eigenvalues(&a).ok_or(StabilityError::NoConvergence)?;
+    check_finite(&ev)?;
     let mut best = Complex::new(f64::NEG_INFINITY, 0.0);
     for e in ev {
         if e.re > best.re || (e.re == best.re && e.im > best.im) {

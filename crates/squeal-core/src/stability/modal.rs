@@ -63,6 +63,7 @@ pub fn eigenpairs(a: &DMatrix<f64>) -> Result<Vec<EigenPair>, StabilityError> {
     let rows: Vec<f64> = (0..n * n).map(|k| a[(k / n, k % n)]).collect();
     if n <= SMALL_MAX {
         let (mut ws, ev) = Workspace::eigenvalues(&rows, n).ok_or(StabilityError::NoConvergence)?;
+        super::check_finite(&ev)?;
         let mut out: Vec<EigenPair> = Vec::with_capacity(n);
         for (k, &lambda) in ev.iter().enumerate() {
             // The second of a conjugate pair (adjacent, exactly conjugate) has
@@ -98,9 +99,11 @@ pub fn eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, StabilityError
     }
     let mut rows: Vec<f64> = (0..n * n).map(|k| a[(k / n, k % n)]).collect();
     if n <= SMALL_MAX {
-        return Workspace::eigenvalues(&rows, n)
+        let ev = Workspace::eigenvalues(&rows, n)
             .map(|(_, ev)| ev)
-            .ok_or(StabilityError::NoConvergence);
+            .ok_or(StabilityError::NoConvergence)?;
+        super::check_finite(&ev)?;
+        return Ok(ev);
     }
     let mut d = vec![1.0; n];
     eigen::balance_flat(&mut rows, n, &mut d);

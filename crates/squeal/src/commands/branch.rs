@@ -6,7 +6,7 @@
 
 use crate::commands::cycle::{self, events_json, Found};
 use crate::commands::simulate::resolve;
-use crate::run::{self, RunError, Staging};
+use crate::run::{RunError, Staging};
 use crate::scenario::{InputError, Scenario};
 use crate::ScenarioArgs;
 use clap::Args;
@@ -119,6 +119,10 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
         .into());
     }
     sc.model.check_simulable().map_err(InputError)?;
+    // i9's validation path, the part that applies to a cycle (which budgets
+    // its own settling): a linearisation that overflows is named by parameter.
+    crate::feasible::scales(&sc.model, Some(&sc))
+        .map_err(|e| crate::feasible::stability_failure(&sc.model, e))?;
     let values: Vec<f64> = (0..n)
         .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
         .collect();
@@ -129,7 +133,7 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
             .and_then(|_| m.validate())
             .map_err(|e| InputError(format!("--param {name}={v}: {e}")))?;
     }
-    run::check_dest(&a.out)?;
+    let stage = Staging::new(&a.out)?;
     let opts = cycle::options(&sc, 20_000_000, 1000.0);
     let names = sc.model.state_names();
     let mut points: Vec<Point> = Vec::with_capacity(n);
@@ -174,7 +178,6 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
                 })),
             })
         });
-    let stage = Staging::new(&a.out)?;
     write_csv(&name, &names, &points, &stage.path("branch.csv"))?;
     draw(&sc, &name, &points, &stage)?;
     let doc = json!({
@@ -192,19 +195,19 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
     crate::output::write_json(&doc, &stage.path("summary.json"))?;
     let dest = stage.commit()?;
     if a.json {
-        println!(
+        crate::outln!(
             "{}",
             serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
         );
     } else {
-        println!(
+        crate::outln!(
             "{}: {} of {} points on the branch over {name} = {lo}…{hi}",
             sc.name,
             points.len(),
             n
         );
         for b in &bifurcations {
-            println!(
+            crate::outln!(
                 "  between {name} = {} and {}: {}",
                 b["between"][0],
                 b["between"][1],
@@ -212,7 +215,7 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
             );
         }
         if let Some(h) = &hopf {
-            println!(
+            crate::outln!(
                 "  steady sliding changes stability at {name} = {} ({:.3} Hz, `critical`); the nearest cycle, at {}, has {:.3} Hz",
                 h["value"],
                 h["freq_hz"].as_f64().unwrap_or(f64::NAN),
@@ -221,9 +224,9 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
             );
         }
         for f in &failures {
-            println!("  no cycle at {name} = {}: {}", f["value"], f["error"]);
+            crate::outln!("  no cycle at {name} = {}: {}", f["value"], f["error"]);
         }
-        println!("output: {}", dest.display());
+        crate::outln!("output: {}", dest.display());
     }
     Ok(())
 }

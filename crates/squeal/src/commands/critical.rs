@@ -28,6 +28,9 @@ pub struct CriticalArgs {
     json: bool,
 }
 
+/// Most points of `critical`'s initial scan (about a second of eigen-analyses).
+pub const MAX_GRID: usize = 100_000;
+
 /// Parse `NAME=LO:HI`.
 pub fn parse_interval(spec: &str, flag: &str) -> Result<(String, f64, f64), InputError> {
     let bad = || {
@@ -45,6 +48,18 @@ pub fn parse_interval(spec: &str, flag: &str) -> Result<(String, f64, f64), Inpu
         return Err(bad());
     }
     Ok((name.trim().to_string(), lo, hi))
+}
+
+/// Both ends of a range must be values the parameter may take: the reason
+/// the one that is not cannot, naming it (LO or HI).
+pub fn check_endpoints(model: &AnyModel, name: &str, lo: f64, hi: f64) -> Result<(), String> {
+    for (end, v) in [("LO", lo), ("HI", hi)] {
+        let mut m = model.clone();
+        if let Err(e) = m.set(name, v) {
+            return Err(format!("{end} = {v}: {e}"));
+        }
+    }
+    Ok(())
 }
 
 /// Least stable growth rate and its frequency with `name` set to `value`.
@@ -70,6 +85,8 @@ pub fn locate(
         ))
         .into());
     }
+    check_endpoints(model, name, lo, hi)
+        .map_err(|why| InputError(format!("--param {name}={lo}:{hi}: {why}")))?;
     let opts = CriticalOptions {
         grid,
         ..CriticalOptions::default()
@@ -83,15 +100,30 @@ pub fn locate(
             lo = nudged;
         }
     }
-    stability::critical(|p| growth_at(model, name, p), lo, hi, &opts).map_err(stability_error)
+    let at = |p: f64| {
+        growth_at(model, name, p).map_err(|e| match e {
+            StabilityError::NonFinite { what } => StabilityError::BadInput(format!(
+                "--param {name}={lo}:{hi}: at {name} = {p:e} the {what} at steady sliding is not finite (it overflows)"
+            )),
+            other => other,
+        })
+    };
+    stability::critical(at, lo, hi, &opts).map_err(|e| match e {
+        StabilityError::BadInput(msg) => RunError::Input(InputError(msg)),
+        other => stability_error(other),
+    })
 }
 
 /// Run the command.
 pub fn run(a: CriticalArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
     let (name, lo, hi) = parse_interval(&a.param, "--param")?;
-    if a.grid < 2 {
-        return Err(InputError(format!("--grid {}: must be ≥ 2", a.grid)).into());
+    if !(2..=MAX_GRID).contains(&a.grid) {
+        return Err(InputError(format!(
+            "--grid {}: must be between 2 and {MAX_GRID} (the scan, then Brent's method, locates the crossing to 1e-10 whatever the grid)",
+            a.grid
+        ))
+        .into());
     }
     let found = locate(&sc.model, &name, lo, hi, a.grid)?;
     if a.json {
@@ -102,14 +134,14 @@ pub fn run(a: CriticalArgs) -> Result<(), RunError> {
             }),
             None => json!({ "param": name, "value": null, "freq_hz": null }),
         };
-        println!(
+        crate::outln!(
             "{}",
             serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
         );
         return Ok(());
     }
     match found {
-        None => println!(
+        None => crate::outln!(
             "{}: no change of stability for {name} in [{lo}, {hi}]",
             sc.name
         ),
@@ -123,9 +155,11 @@ pub fn run(a: CriticalArgs) -> Result<(), RunError> {
             } else {
                 "Hopf point"
             };
-            println!(
+            crate::outln!(
                 "{}: critical {name} = {:.12e} ({kind}; {side}); the crossing mode is at {:.3} Hz",
-                sc.name, c.value, c.freq_hz
+                sc.name,
+                c.value,
+                c.freq_hz
             );
         }
     }

@@ -16,9 +16,12 @@ pub struct ListenArgs {
     /// The velocity to hear (default: the disc's tangential velocity).
     #[arg(long)]
     signal: Option<String>,
-    /// Output WAV file.
+    /// Output WAV file (never an existing file, unless --force).
     #[arg(long, default_value = "squeal.wav")]
     out: PathBuf,
+    /// Replace an existing --out file.
+    #[arg(long)]
+    force: bool,
     /// 32-bit float samples instead of 16-bit PCM.
     #[arg(long)]
     float: bool,
@@ -26,13 +29,10 @@ pub struct ListenArgs {
 
 /// Run the command.
 pub fn run(a: ListenArgs) -> Result<(), RunError> {
-    if a.out.is_dir() {
-        return Err(InputError(format!(
-            "--out {}: is a folder; name a .wav file",
-            a.out.display()
-        ))
-        .into());
-    }
+    // Written beside the target and renamed into place: a failure or an
+    // interrupt leaves no partial file, and no file is replaced unasked.
+    // Staged before the work, so an unwritable place is found at once.
+    let staged = crate::staging::StagedFile::new("--out", &a.out, a.force)?;
     let dir = Path::new(&a.scenario.scenario);
     let (run, model) = if dir.is_dir() {
         if !a.scenario.sets.is_empty() {
@@ -47,7 +47,7 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
             .to_string();
         (run, model)
     } else {
-        let sc = crate::commands::simulate::resolve(&a.scenario)?;
+        let sc = crate::commands::simulate::resolve_run(&a.scenario, None)?;
         (run::run(&sc)?, sc.model.name().to_string())
     };
     let name = a
@@ -66,22 +66,8 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
             vels.join(", ")
         ))
     })?;
-    if let Some(parent) = a.out.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent)
-            .map_err(|e| RunError::Io(format!("cannot create {}: {e}", parent.display())))?;
-    }
-    // Write beside the target and rename, so a failure leaves no partial file.
-    let tmp = a.out.with_extension("wav.partial");
-    let clip = analysis::write_wav(x, run.sample_rate, &tmp, a.float);
-    let clip = match clip {
-        Ok(c) => c,
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            return Err(e);
-        }
-    };
-    std::fs::rename(&tmp, &a.out)
-        .map_err(|e| RunError::Io(format!("cannot write {}: {e}", a.out.display())))?;
+    let clip = analysis::write_wav(x, run.sample_rate, staged.path(), a.float)?;
+    staged.commit("--out")?;
     if clip.looped {
         eprintln!(
             "note: the run ({:.3} s) is shorter than {:.1} s of sound: its last steady part is looped",
@@ -89,7 +75,7 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
             clip.duration()
         );
     }
-    println!(
+    crate::outln!(
         "{}: {name} at true pitch, {:.2} s, {} Hz, {}",
         a.out.display(),
         clip.duration(),

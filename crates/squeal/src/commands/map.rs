@@ -3,7 +3,7 @@
 //! nonlinear (simulation), in parallel and deterministic.
 
 use crate::commands::critical::growth_at;
-use crate::commands::simulate::resolve;
+use crate::commands::simulate::{resolve, resolve_run};
 use crate::model::AnyModel;
 use crate::run::{progress_bar, RunError, Staging};
 use crate::scenario::{InputError, Scenario};
@@ -12,6 +12,7 @@ use clap::Args;
 use rayon::prelude::*;
 use serde_json::json;
 use squeal_core::integrate::{Flow, Sink};
+use squeal_core::stability::StabilityError;
 use squeal_core::System;
 use squeal_core::{simulate, EventKind, Mode};
 use squeal_plot::{Colormap, Format, HeatmapSpec};
@@ -98,6 +99,7 @@ pub fn parse_axis(spec: &str, flag: &str, log: bool, model: &AnyModel) -> Result
             model.name()
         )));
     }
+    crate::commands::critical::check_endpoints(model, &name, lo, hi).map_err(|why| bad(&why))?;
     let values = (0..n)
         .map(|i| {
             let s = i as f64 / (n - 1) as f64;
@@ -125,28 +127,42 @@ pub fn unit_of(model: &AnyModel, name: &str) -> &'static str {
 
 /// Linear map: `(σ_max, freq_hz)` per point, row-major over y then x; NaN
 /// where steady sliding does not exist or the parameters are invalid.
+/// A point whose state matrix is not finite is an error (naming the point
+/// and the parameter to blame), not a blank.
 pub fn linear_grid(
     model: &AnyModel,
     x: &Axis,
     y: &Axis,
     progress: &indicatif::ProgressBar,
-) -> Vec<(f64, f64)> {
+) -> Result<Vec<(f64, f64)>, RunError> {
     let nx = x.values.len();
-    (0..nx * y.values.len())
+    let points: Vec<Result<(f64, f64), RunError>> = (0..nx * y.values.len())
         .into_par_iter()
         .map(|k| {
             let (i, j) = (k % nx, k / nx);
             let mut m = model.clone();
             let r = m
                 .set(&y.name, y.values[j])
-                .map_err(|e| e.to_string())
-                .and_then(|_| growth_at(&m, &x.name, x.values[i]).map_err(|e| e.to_string()));
+                .map_err(StabilityError::from)
+                .and_then(|_| growth_at(&m, &x.name, x.values[i]));
             if i == 0 {
                 progress.inc(nx as u64);
             }
-            r.unwrap_or((f64::NAN, f64::NAN))
+            match r {
+                Ok(p) => Ok(p),
+                Err(e @ StabilityError::NonFinite { .. }) => {
+                    let _ = m.set(&x.name, x.values[i]);
+                    let why = crate::feasible::stability_failure(&m, e);
+                    Err(RunError::Input(InputError(format!(
+                        "at {} = {:e}, {} = {:e}: {why}",
+                        x.name, x.values[i], y.name, y.values[j]
+                    ))))
+                }
+                Err(_) => Ok((f64::NAN, f64::NAN)),
+            }
         })
-        .collect()
+        .collect();
+    points.into_iter().collect()
 }
 
 /// Outcome of one transient run.
@@ -303,6 +319,8 @@ pub fn transient_grid(
                 .and_then(|_| s.model.set(&y.name, y.values[j]))
                 .and_then(|_| s.model.validate())
                 .map_err(|e| e.to_string())
+                // Each point gets its own step budget (its stiffness differs).
+                .and_then(|_| crate::feasible::prepare(&mut s).map_err(|e| e.to_string()))
                 .and_then(|_| {
                     crate::with_system!(&s.model, m => transient_point(m, &s),
                     else => Err(s.model.check_simulable().err().unwrap_or_default()))
@@ -365,10 +383,12 @@ fn num(x: f64) -> String {
 
 /// Run the command.
 pub fn run(a: MapArgs) -> Result<(), RunError> {
-    let mut sc = resolve(&a.scenario)?;
-    if let Some(d) = a.duration {
-        sc.apply("duration", &crate::scenario::Setting::Number(d))?;
-    }
+    // The same checks as `simulate` whenever the map simulates.
+    let sc = if a.transient || a.duration.is_some() {
+        resolve_run(&a.scenario, a.duration)?
+    } else {
+        resolve(&a.scenario)?
+    };
     let x = parse_axis(&a.x, "--x", a.log_x, &sc.model)?;
     let y = parse_axis(&a.y, "--y", a.log_y, &sc.model)?;
     if x.name == y.name {
@@ -382,10 +402,15 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-map", sc.name)));
-    crate::run::check_dest(&dest)?;
+    let flag = if a.out.is_some() {
+        "--out"
+    } else {
+        "output folder (default --out)"
+    };
+    let stage = Staging::new_as(flag, &dest)?;
     let n = x.values.len() * y.values.len();
     let pb = progress_bar(n as u64, "eigen-analysis");
-    let lin = linear_grid(&sc.model, &x, &y, &pb);
+    let lin = linear_grid(&sc.model, &x, &y, &pb)?;
     pb.finish_and_clear();
     let trans = if a.transient {
         let pb = progress_bar(n as u64, "simulating");
@@ -395,7 +420,6 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
     } else {
         None
     };
-    let stage = Staging::new(&dest)?;
     let path = stage.path("map.csv");
     let io = |e: std::io::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
     let mut w = std::io::BufWriter::new(std::fs::File::create(&path).map_err(io)?);
@@ -506,23 +530,23 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
             "x": x.name, "y": y.name, "points": n, "unstable": unstable, "no_steady_sliding": nan,
             "linear_nonlinear_disagree": trans.as_ref().map(|_| disagree), "out": dest,
         });
-        println!(
+        crate::outln!(
             "{}",
             serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
         );
     } else {
-        println!(
+        crate::outln!(
             "{}: {n} points ({} × {}), {unstable} unstable, {nan} without steady sliding",
             sc.name,
             x.values.len(),
             y.values.len()
         );
         if trans.is_some() {
-            println!(
+            crate::outln!(
                 "linear verdict and simulated outcome disagree at {disagree} points (see map.csv)"
             );
         }
-        println!(
+        crate::outln!(
             "output: {} (map.csv, map.png{})",
             dest.display(),
             if trans.is_some() {

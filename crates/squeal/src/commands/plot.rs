@@ -27,9 +27,13 @@ pub fn run(a: PlotArgs) -> Result<(), RunError> {
         .to_string();
     let channels = channels_for(model);
     let an = analysis::analyse(&run, &channels, &settings);
-    analysis::draw(&run, &an, &channels, &name, &a.run_dir)?;
-    analysis::write_spectrum_csv(&an, &a.run_dir.join("spectrum.csv"))?;
-    println!(
+    // Drawn into a scratch folder first; each file then replaces only a file
+    // squeal wrote (or none) in the run folder.
+    let scratch = crate::staging::Staging::scratch(&a.run_dir)?;
+    analysis::draw(&run, &an, &channels, &name, scratch.dir())?;
+    analysis::write_spectrum_csv(&an, &scratch.path("spectrum.csv"))?;
+    crate::staging::replace_files(&a.run_dir, scratch.dir())?;
+    crate::outln!(
         "pictures redrawn in {} (triplet, spectrogram, phase; PNG and SVG)",
         a.run_dir.display()
     );

@@ -599,7 +599,7 @@ fn durations(rs: &[SetResult]) -> String {
         .join("; ")
 }
 
-fn report_md(rs: &[SetResult], cs: &[Conclusion], scale: f64, figures: bool, wall: f64) -> String {
+fn report_md(rs: &[SetResult], cs: &[Conclusion], scale: f64, figures: bool) -> String {
     let mut m = String::new();
     let _ = writeln!(
         m,
@@ -607,7 +607,7 @@ fn report_md(rs: &[SetResult], cs: &[Conclusion], scale: f64, figures: bool, wal
     );
     let _ = writeln!(
         m,
-        "Produced by `squeal reproduce` in {wall:.1} s. The 40 parameter sets reconstruct Table 11.1 of V. Milovs, \
+        "Produced by `squeal reproduce`. The 40 parameter sets reconstruct Table 11.1 of V. Milovs, \
          *Computer Simulation of Automotive Disc Brake Noise* (its numbers were lost to OCR; see MODEL.md §6 and \
          `scenarios/thesis/`). Every run starts from rest with N applied as a step at t = 0, as the thesis did, and \
          is integrated exactly (event-located stick, slip, reversal, separation). Simulated durations: {}{}: \
@@ -945,6 +945,7 @@ pub fn run(a: ReproduceArgs) -> Result<(), RunError> {
     for s in &mut sets {
         let d = s.duration * a.duration_scale;
         s.apply("duration", &Setting::Number(d))?;
+        crate::feasible::prepare(s)?;
     }
     let stage = Staging::new(&a.out)?;
     let figures = stage.dir().join("figures");
@@ -981,21 +982,21 @@ pub fn run(a: ReproduceArgs) -> Result<(), RunError> {
         "conclusions.json",
         &(serde_json::to_string_pretty(&cj).map_err(|e| RunError::Io(e.to_string()))? + "\n"),
     )?;
-    let md = report_md(&rs, &cs, a.duration_scale, !a.no_figures, wall);
+    let md = report_md(&rs, &cs, a.duration_scale, !a.no_figures);
     write("report.md", &md)?;
     write("report.html", &report_html(&md))?;
     let dest = stage.commit()?;
     let held = cs.iter().filter(|c| c.held).count();
-    println!("reproduced 40 sets in {wall:.1} s: {held} of 7 conclusions held");
+    crate::outln!("reproduced 40 sets in {wall:.1} s: {held} of 7 conclusions held");
     for c in &cs {
-        println!(
+        crate::outln!(
             "  {}. {} {}",
             c.id,
             if c.held { "held    " } else { "NOT held" },
             c.thesis
         );
     }
-    println!("report: {}", dest.join("report.html").display());
+    crate::outln!("report: {}", dest.join("report.html").display());
     Ok(())
 }
 

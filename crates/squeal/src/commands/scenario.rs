@@ -22,10 +22,10 @@ pub fn run(cmd: ScenarioCmd) -> Result<(), RunError> {
         ScenarioCmd::List => {
             for name in BUILTINS {
                 let s = Scenario::builtin(name).expect("listed built-ins exist");
-                println!("{name:<14} {}", s.description);
+                crate::outln!("{name:<14} {}", s.description);
             }
             for (i, s) in crate::scenario::thesis_sets().iter().enumerate() {
-                println!("thesis-{:02}      {}", i + 1, s.description);
+                crate::outln!("thesis-{:02}      {}", i + 1, s.description);
             }
         }
         ScenarioCmd::Show { name } => {
@@ -35,7 +35,7 @@ pub fn run(cmd: ScenarioCmd) -> Result<(), RunError> {
                     BUILTINS.join(", ")
                 ))
             })?;
-            print!("{}", s.to_toml());
+            crate::out::text(&s.to_toml());
         }
     }
     Ok(())

@@ -46,7 +46,7 @@ pub struct SpectrumArgs {
     #[arg(long, default_value_t = crate::analysis::SEGMENT)]
     segment: usize,
     /// Overlap of consecutive segments (0 to 0.95).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
     overlap: f64,
     /// Peak-amplitude spectrum instead of the power spectral density.
     #[arg(long)]
@@ -67,19 +67,27 @@ impl SpectrumArgs {
 
 /// Resolve the scenario named on the command line, with its overrides.
 pub fn resolve(args: &ScenarioArgs) -> Result<Scenario, InputError> {
+    crate::scenario::check_set_syntax(&args.sets, &args.scenario)?;
     let mut sc = Scenario::load(&args.scenario)?;
     sc.apply_overrides(&args.sets)?;
     Ok(sc)
 }
 
-/// Run the command.
-pub fn run(a: SimulateArgs) -> Result<(), RunError> {
-    let mut sc = resolve(&a.scenario)?;
-    if let Some(d) = a.duration {
+/// Resolve a scenario for a run — with `--duration` if given — and check it
+/// the one way every simulating command does ([`crate::feasible::prepare`]).
+pub fn resolve_run(args: &ScenarioArgs, duration: Option<f64>) -> Result<Scenario, RunError> {
+    let mut sc = resolve(args)?;
+    if let Some(d) = duration {
         sc.apply("duration", &Setting::Number(d))
             .map_err(|e| InputError(format!("--duration: {}", e.0)))?;
-        sc.validate()?;
     }
+    crate::feasible::prepare(&mut sc)?;
+    Ok(sc)
+}
+
+/// Run the command.
+pub fn run(a: SimulateArgs) -> Result<(), RunError> {
+    let sc = resolve_run(&a.scenario, a.duration)?;
     let spectrum_settings = a.spectrum.settings()?;
     let (mut csv, mut npy) = (false, false);
     for f in &a.format {
@@ -95,10 +103,14 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
-    run::check_dest(&dest)?;
+    let flag = if a.out.is_some() {
+        "--out"
+    } else {
+        "output folder (default --out)"
+    };
+    let stage = Staging::new_as(flag, &dest)?;
     let run = run::run(&sc)?;
     let t0 = Instant::now();
-    let stage = Staging::new(&dest)?;
     if csv {
         output::write_series_csv(&run, &stage.path("series.csv"))?;
     }
@@ -142,7 +154,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
     output::write_json(&summary, &stage.path("summary.json"))?;
     let dest = stage.commit()?;
     if a.json {
-        println!(
+        crate::outln!(
             "{}",
             serde_json::to_string_pretty(&summary).map_err(|e| RunError::Io(e.to_string()))?
         );
@@ -154,7 +166,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
 
 fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest: &std::path::Path) {
     let s = &run.info.stats;
-    println!(
+    crate::outln!(
         "{} ({}): {} s simulated in {:.2} s — {} steps ({} rejected), {} RHS evaluations",
         sc.name,
         sc.model.name(),
@@ -168,7 +180,7 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
         .iter()
         .map(|k| format!("{} {}", s.event_count(*k), k.as_str()))
         .collect();
-    println!(
+    crate::outln!(
         "events: {}; stick fraction {:.3e}",
         ev.join(", "),
         s.stick_fraction()
@@ -178,7 +190,7 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
             .iter()
             .map(|(k, v)| format!("{k} {:.3e}", v.as_f64().unwrap_or(0.0)))
             .collect();
-        println!(
+        crate::outln!(
             "RMS velocity over the last 20 % (m/s): {}",
             parts.join(", ")
         );
@@ -193,8 +205,8 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
         .filter_map(|k| fmt(k))
         .collect();
     if !dom.is_empty() {
-        println!("dominant frequencies: {}", dom.join(", "));
+        crate::outln!("dominant frequencies: {}", dom.join(", "));
     }
-    println!("verdict: {}", summary["verdict"].as_str().unwrap_or("?"));
-    println!("output: {}", dest.display());
+    crate::outln!("verdict: {}", summary["verdict"].as_str().unwrap_or("?"));
+    crate::outln!("output: {}", dest.display());
 }

@@ -77,6 +77,7 @@ pub fn stability_error(e: StabilityError) -> RunError {
     match e {
         StabilityError::NoSteadySliding(_)
         | StabilityError::Param(_)
+        | StabilityError::NonFinite { .. }
         | StabilityError::BadInterval { .. } => RunError::Input(InputError(e.to_string())),
         other => RunError::Numerical(other.to_string()),
     }
@@ -187,11 +188,11 @@ pub fn levers(model: &AnyModel) -> Vec<Lever> {
 pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
     if let Some(dest) = &a.out {
-        crate::run::check_dest(dest)?;
+        crate::staging::check_dest_as("--out", dest)?;
     }
-    let an = analyse(&sc.model).map_err(stability_error)?;
+    let an = analyse(&sc.model).map_err(|e| crate::feasible::stability_failure(&sc.model, e))?;
     if let Some(dest) = &a.out {
-        let stage = crate::run::Staging::new(dest)?;
+        let stage = crate::run::Staging::new_as("--out", dest)?;
         write_modes_csv(&stage.path("modes.csv"), &sc.model, &an)?;
         stage.commit()?;
     }
@@ -206,7 +207,7 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
             .iter()
             .map(|l| json!({ "param": l.param, "from": l.from, "to": l.to, "freq_hz": l.freq_hz }))
             .collect::<Vec<_>>());
-        println!(
+        crate::outln!(
             "{}",
             serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
         );
@@ -217,18 +218,22 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     } else {
         "UNSTABLE: it squeals"
     };
-    println!(
+    crate::outln!(
         "{} ({}): steady sliding is {verdict} (max growth rate {:+.6e} 1/s)",
         sc.name,
         sc.model.name(),
         an.max_growth_rate
     );
-    println!(
+    crate::outln!(
         "{:>3}  {:>15}  {:>15}  {:>12}  {:>14}  dominant",
-        "#", "σ (1/s)", "ω (rad/s)", "freq (Hz)", "damping ratio"
+        "#",
+        "σ (1/s)",
+        "ω (rad/s)",
+        "freq (Hz)",
+        "damping ratio"
     );
     for (i, e) in an.eigen.iter().enumerate() {
-        println!(
+        crate::outln!(
             "{:>3}  {:>+15.6e}  {:>+15.6e}  {:>12.2}  {:>+14.4e}  {}{}",
             i + 1,
             e.re,
@@ -240,19 +245,21 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         );
     }
     let ls = an.least_stable_mode();
-    println!(
+    crate::outln!(
         "least stable mode: {:.2} Hz, dominated by {}, σ = {:+.6e} 1/s",
-        ls.freq_hz, ls.dominant_name, ls.re
+        ls.freq_hz,
+        ls.dominant_name,
+        ls.re
     );
     if large {
-        println!(
+        crate::outln!(
             "(levers are searched only for models of up to {} dofs)",
             squeal_core::model::lumped::MAX_SIM_DOFS
         );
     } else if levers.is_empty() {
-        println!("no single parameter change within ×1000 either way changes the verdict");
+        crate::outln!("no single parameter change within ×1000 either way changes the verdict");
     } else {
-        println!(
+        crate::outln!(
             "{} by changing one parameter (all others as they are):",
             if an.stable {
                 "it would start to squeal"
@@ -262,7 +269,7 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         );
         for l in &levers {
             let verb = if l.to > l.from { "raise" } else { "lower" };
-            println!(
+            crate::outln!(
                 "  {verb} {:<6} from {:<11} to {:.6e} {} (the {:.1} Hz mode crosses there)",
                 l.param,
                 format!("{:.4e}", l.from),

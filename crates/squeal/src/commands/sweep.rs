@@ -84,7 +84,7 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", sc.name)));
-    crate::run::check_dest(&dest)?;
+    let stage = Staging::new(&dest)?;
     let sw = sweep_model(&sc.model, &axis.name, &axis.values).map_err(|(e, at)| match e {
         StabilityError::Param(_) => {
             RunError::Input(InputError(format!("--param {}: {e}", a.param)))
@@ -95,7 +95,6 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
         ))),
         other => RunError::Numerical(format!("eigen-analysis at {} = {at}: {other}", axis.name)),
     })?;
-    let stage = Staging::new(&dest)?;
     let path = stage.path("sweep.csv");
     let io = |e: std::io::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
     let mut w = std::io::BufWriter::new(std::fs::File::create(&path).map_err(io)?);
@@ -198,13 +197,13 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
             "onsets": onsets,
             "out": out.display().to_string(),
         });
-        println!(
+        crate::outln!(
             "{}",
             serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
         );
         return Ok(());
     }
-    println!(
+    crate::outln!(
         "{}: {} modes over {} values of {} → {}",
         sc.name,
         sw.listed.len(),
@@ -213,7 +212,7 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
         out.display()
     );
     if sw.onsets.is_empty() {
-        println!("  no change of stability in the sweep");
+        crate::outln!("  no change of stability in the sweep");
     }
     for o in &sw.onsets {
         let what = match (o.coalescence, o.direction) {
@@ -222,7 +221,7 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
             (false, Direction::Destabilising) => "a mode starts to grow",
             (false, Direction::Stabilising) => "a mode stops growing",
         };
-        println!(
+        crate::outln!(
             "  {} = {:.10e}: {what} ({:.2} Hz{})",
             axis.name,
             o.value,
