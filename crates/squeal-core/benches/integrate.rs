@@ -4,9 +4,10 @@
 #![allow(missing_docs)] // criterion_group! generates undocumented items
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use squeal_core::model::lumped::{disc_pad_spec, Fixed};
 use squeal_core::model::{EventKind, GuardKind, Guards, Mode, Model, ModelError, Observables};
 use squeal_core::sink::Discard;
-use squeal_core::{simulate, Belt, DiscPad, FrictionLaw, SolverOptions};
+use squeal_core::{simulate, Belt, DiscPad, FrictionLaw, Lumped, SolverOptions};
 use std::time::Duration;
 
 /// The disc–pad slip equations with no guards: the same method and right-hand
@@ -57,6 +58,22 @@ fn benches(c: &mut Criterion) {
         b.iter(|| {
             simulate(
                 &disc,
+                0.0,
+                [0.0; 8],
+                1.0,
+                200_000.0,
+                SolverOptions::default(),
+                &mut Discard,
+            )
+            .unwrap()
+        })
+    });
+    // The same brake as a lumped model (BENCHMARKS.md: target ≤ 1.3× the dedicated model).
+    let lumped = Lumped::build(&disc_pad_spec(&disc)).unwrap();
+    g.bench_function("lumped_disc_pad_default_1s_from_rest", |b| {
+        b.iter(|| {
+            simulate(
+                &Fixed::<8>(&lumped),
                 0.0,
                 [0.0; 8],
                 1.0,

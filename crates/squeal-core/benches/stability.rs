@@ -11,8 +11,9 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use rayon::prelude::*;
+use squeal_core::model::lumped::{two_pad_spec, Fixed};
 use squeal_core::stability::{analyse, max_growth_rate};
-use squeal_core::DiscPad;
+use squeal_core::{DiscPad, Lumped};
 use std::time::Duration;
 
 const SIDE: usize = 500;
@@ -40,6 +41,21 @@ fn benches(c: &mut Criterion) {
     });
     g.bench_function("max_growth_rate_disc_pad", |b| {
         b.iter(|| max_growth_rate(black_box(&disc)).unwrap())
+    });
+    // The 6-dof two-pad brake (lumped, 2 contacts): BENCHMARKS.md's target is
+    // ≥ 20 000 full analyses per second per core.
+    let two = Lumped::build(&two_pad_spec()).unwrap();
+    g.bench_function("analyse_two_pad_brake", |b| {
+        b.iter(|| analyse(&Fixed::<12>(black_box(&two))).unwrap())
+    });
+    g.bench_function("equilibrium_jacobian_two_pad_brake", |b| {
+        b.iter(|| {
+            let z = black_box(&two).equilibrium_dyn().unwrap();
+            two.jacobian_dyn(&z)
+        })
+    });
+    g.bench_function("max_growth_rate_two_pad_brake", |b| {
+        b.iter(|| max_growth_rate(&Fixed::<12>(black_box(&two))).unwrap())
     });
     g.finish();
 

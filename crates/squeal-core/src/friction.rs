@@ -333,6 +333,55 @@ impl FrictionLaw {
         }
     }
 
+    /// Whether μ does not depend on the sliding speed (Coulomb).
+    pub fn is_constant(&self) -> bool {
+        matches!(self, FrictionLaw::Coulomb { .. })
+    }
+
+    /// Upper bounds of `|μ(v)|` and `|dμ/dv|` for `v ∈ [lo, hi]` (the
+    /// formulas [`Self::mu`] and [`Self::dmu`] evaluate there, continuation
+    /// below 0 included). Used to prove that a guard cannot cross zero between
+    /// two points; `INFINITY` where no finite bound exists.
+    pub fn bounds(&self, lo: f64, hi: f64) -> (f64, f64) {
+        let (lo, hi) = (lo.min(hi), lo.max(hi));
+        match *self {
+            FrictionLaw::Thesis { uc, .. } => {
+                // μ is a parabola with its vertex at Uc, dμ/dv is linear.
+                let mut m = self.mu(lo).abs().max(self.mu(hi).abs());
+                if lo < uc && uc < hi {
+                    m = m.max(self.mu(uc).abs());
+                }
+                (m, self.dmu(lo).abs().max(self.dmu(hi).abs()))
+            }
+            FrictionLaw::Coulomb { mu_k, .. } => (mu_k.abs(), 0.0),
+            FrictionLaw::Stribeck {
+                mu_s,
+                mu_k,
+                v_s,
+                delta,
+                sigma,
+            } => {
+                let vmax = lo.abs().max(hi.abs());
+                let m = mu_k.abs() + (mu_s - mu_k).abs() + sigma.abs() * vmax;
+                // r^(δ−1)·exp(−r^δ) ≤ 1 for δ ≥ 1 (its maximum, at r^δ = 1 − 1/δ).
+                let d = if delta >= 1.0 {
+                    (mu_s - mu_k).abs() * delta / v_s + sigma.abs()
+                } else {
+                    f64::INFINITY
+                };
+                (m, d)
+            }
+            FrictionLaw::Rational { mu_s, delta } => {
+                let d0 = 1.0 + delta * lo;
+                if d0 <= 0.0 {
+                    (f64::INFINITY, f64::INFINITY)
+                } else {
+                    (mu_s.abs() / d0, mu_s.abs() * delta / (d0 * d0))
+                }
+            }
+        }
+    }
+
     /// Static coefficient μ_s: the stick force bound is μ_s times the normal force.
     #[inline]
     pub fn mu_static(&self) -> f64 {

@@ -1,6 +1,6 @@
 //! Initial states: `rest` or `equilibrium`, plus per-state offsets.
 
-use crate::model::{Model, ModelError};
+use crate::model::{ModelError, System};
 
 /// How a run starts (before offsets).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -32,14 +32,14 @@ impl Initial {
 }
 
 /// The initial state `base + offsets`.
-pub fn initial_state<M: Model<N>, const N: usize>(
+pub fn initial_state<M: System<N> + ?Sized, const N: usize>(
     model: &M,
     initial: Initial,
     offsets: &[f64; N],
 ) -> Result<[f64; N], ModelError> {
     let mut z = match initial {
         Initial::Rest => [0.0; N],
-        Initial::Equilibrium => model.equilibrium()?,
+        Initial::Equilibrium => model.steady_sliding()?,
     };
     for i in 0..N {
         z[i] += offsets[i];

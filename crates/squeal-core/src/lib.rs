@@ -34,9 +34,11 @@
 //! assert_eq!(run.stats.event_count(EventKind::Reverse), 0); // too early for stick-slip
 //! ```
 
+pub mod cycle;
 pub mod friction;
 pub mod initial;
 pub mod integrate;
+pub mod matrix_market;
 pub mod model;
 pub mod params;
 pub mod sink;
@@ -45,8 +47,8 @@ pub mod stability;
 pub use friction::FrictionLaw;
 pub use integrate::{simulate, Flow, IntegrateError, RunInfo, Sink, Solver, SolverOptions, Stats};
 pub use model::{
-    belt::Belt, disc_pad::DiscPad, hoffmann::Hoffmann, EventKind, Mode, Model, ModelError,
-    Parameters,
+    belt::Belt, disc_pad::DiscPad, hoffmann::Hoffmann, lumped::Lumped, EventKind, Mode, Model,
+    ModelError, Modes, Parameters, System,
 };
 pub use params::{ParamError, ParamSpec};
 pub use stability::{analyse, critical, max_growth_rate, Analysis, StabilityError};

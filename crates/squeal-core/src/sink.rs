@@ -1,7 +1,7 @@
 //! Ready-made [`Sink`]s: record everything, or only the events.
 
 use crate::integrate::{Flow, Sink};
-use crate::model::{EventKind, Mode};
+use crate::model::{EventKind, Mode, Modes};
 
 /// One recorded event.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -12,8 +12,12 @@ pub struct EventRecord<const N: usize> {
     pub kind: EventKind,
     /// State at the event.
     pub z: [f64; N],
-    /// Mode after the event.
+    /// Mode after the event (of the first contact).
     pub mode: Mode,
+    /// The contact the event belongs to (0 for one-contact models).
+    pub contact: usize,
+    /// Modes of every contact after the event.
+    pub modes: Modes,
 }
 
 /// Keeps every sample and event in memory.
@@ -57,11 +61,23 @@ impl<const N: usize> Sink<N> for Recorder<N> {
         Flow::Continue
     }
     fn event(&mut self, t: f64, kind: EventKind, z: &[f64; N], mode: Mode) {
+        self.contact_event(t, kind, 0, z, &Modes::single(mode));
+    }
+    fn contact_event(
+        &mut self,
+        t: f64,
+        kind: EventKind,
+        contact: usize,
+        z: &[f64; N],
+        modes: &Modes,
+    ) {
         self.events.push(EventRecord {
             t,
             kind,
             z: *z,
-            mode,
+            mode: modes.first(),
+            contact,
+            modes: *modes,
         });
     }
 }
@@ -78,11 +94,23 @@ impl<const N: usize> Sink<N> for EventLog<N> {
         Flow::Continue
     }
     fn event(&mut self, t: f64, kind: EventKind, z: &[f64; N], mode: Mode) {
+        self.contact_event(t, kind, 0, z, &Modes::single(mode));
+    }
+    fn contact_event(
+        &mut self,
+        t: f64,
+        kind: EventKind,
+        contact: usize,
+        z: &[f64; N],
+        modes: &Modes,
+    ) {
         self.events.push(EventRecord {
             t,
             kind,
             z: *z,
-            mode,
+            mode: modes.first(),
+            contact,
+            modes: *modes,
         });
     }
 }

@@ -1,5 +1,5 @@
 //! Pictures for squeal: stacked line panels (time series, spectra), heatmaps
-//! (spectrograms, stability maps) and phase portraits, written as PNG and/or SVG.
+//! (spectrograms, stability maps), phase portraits and mode-coupling diagrams, written as PNG and/or SVG.
 //!
 //! The crate takes plain data (slices) and knows nothing of the physics. Every plot
 //! function takes an output path *stem* and a list of [`Format`]s and writes
@@ -18,6 +18,7 @@ mod contour;
 mod decimate;
 mod heatmap;
 mod lines;
+mod modes;
 mod output;
 mod style;
 
@@ -26,6 +27,7 @@ use std::path::PathBuf;
 pub use contour::{zero_contour, Segment};
 pub use heatmap::{heatmap, Colormap, HeatmapSpec};
 pub use lines::{line_panels, phase_portrait, Labels, Panel, Peak, Series};
+pub use modes::{mode_coupling, BranchSeries, ModeCouplingSpec};
 pub use style::FONT_FAMILY;
 
 /// Default size (pixels) for multi-panel figures such as the velocity/PSD triplet.

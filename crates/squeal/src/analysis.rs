@@ -225,8 +225,8 @@ pub fn analyse(
             })
         })
     };
-    let tangential = named(Some(ch.tangential));
-    let normal = named(ch.normal);
+    let tangential = named(Some(ch.tangential.as_str()));
+    let normal = named(ch.normal.as_deref());
     let mut growth = Vec::new();
     for (name, col) in run.columns.iter().zip(&run.data) {
         if !name.starts_with('v') || name == "v_rel" {

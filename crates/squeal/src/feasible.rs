@@ -7,9 +7,10 @@
 use crate::model::AnyModel;
 use crate::run::RunError;
 use crate::scenario::{InputError, Scenario};
+use nalgebra::Complex;
 use squeal_core::integrate::budget::{min_steps, step_budget};
-use squeal_core::stability::{self, Inertia, StabilityError};
-use squeal_core::Model;
+use squeal_core::stability::{self, Analysis, StabilityError};
+use squeal_core::System;
 
 /// Most bytes the sampled series of one run may take in memory (1 GiB).
 pub const MAX_SERIES_BYTES: f64 = 1024.0 * 1024.0 * 1024.0;
@@ -29,23 +30,23 @@ pub struct Scales {
     pub lambda_max: f64,
     /// The coordinate dominating that mode ("" if it is a mode at the
     /// initial state rather than at steady sliding).
-    pub dominant: &'static str,
+    pub dominant: String,
     /// Highest mode frequency |Im λ|/2π (Hz).
     pub f_max_hz: f64,
 }
 
-fn scales_of<M: Model<N> + Inertia, const N: usize>(
-    m: &M,
-    z0: Option<[f64; N]>,
+fn scales_of(
+    an: Result<Analysis, StabilityError>,
+    at_start: Option<Vec<Complex<f64>>>,
 ) -> Result<Option<Scales>, StabilityError> {
     let mut s: Option<Scales> = None;
-    let mut take = |modulus: f64, im: f64, dominant: &'static str| {
+    let mut take = |modulus: f64, im: f64, dominant: &str| {
         let f = im.abs() / (2.0 * std::f64::consts::PI);
         match &mut s {
             None => {
                 s = Some(Scales {
                     lambda_max: modulus,
-                    dominant,
+                    dominant: dominant.to_string(),
                     f_max_hz: f,
                 })
             }
@@ -53,12 +54,12 @@ fn scales_of<M: Model<N> + Inertia, const N: usize>(
                 s.f_max_hz = s.f_max_hz.max(f);
                 if modulus > s.lambda_max {
                     s.lambda_max = modulus;
-                    s.dominant = dominant;
+                    s.dominant = dominant.to_string();
                 }
             }
         }
     };
-    match stability::analyse_with_masses(m, &m.position_masses()) {
+    match an {
         Ok(an) => {
             for e in &an.eigen {
                 if !(e.re.is_finite() && e.im.is_finite()) {
@@ -66,32 +67,31 @@ fn scales_of<M: Model<N> + Inertia, const N: usize>(
                         what: "spectrum (eigenvalues)",
                     });
                 }
-                take(e.re.hypot(e.im), e.im, e.dominant_name);
+                take(e.re.hypot(e.im), e.im, &e.dominant_name);
             }
         }
         Err(e @ StabilityError::NonFinite { .. }) => return Err(e),
         Err(_) => {}
     }
-    if let Some(z) = z0 {
-        let a = m.jacobian(&z);
-        if let Some(ev) = stability::eigen::eigenvalues(&a) {
-            for l in ev {
-                if l.re.is_finite() && l.im.is_finite() {
-                    take(l.re.hypot(l.im), l.im, "");
-                }
-            }
+    for l in at_start.unwrap_or_default() {
+        if l.re.is_finite() && l.im.is_finite() {
+            take(l.re.hypot(l.im), l.im, "");
         }
     }
     Ok(s)
 }
 
 /// The fastest time scales of a model (at steady sliding, and at `sc`'s
-/// initial state if given); `None` if neither can be linearised.
+/// initial state if given); `None` if neither can be linearised. A lumped
+/// model too large to simulate is judged at steady sliding only.
 pub fn scales(model: &AnyModel, sc: Option<&Scenario>) -> Result<Option<Scales>, StabilityError> {
-    crate::with_model!(model, m => {
-        let z0 = sc.and_then(|sc| crate::run::initial_of(m, sc).ok());
-        scales_of(m, z0)
-    })
+    let an = model.analyse();
+    let at_start = crate::with_system!(model, m => {
+        sc.and_then(|sc| crate::run::initial_of(m, sc).ok())
+            .and_then(|z| stability::eigen::eigenvalues(&m.state_jacobian(&z)))
+            .map(|ev| ev.to_vec())
+    }, else => None);
+    scales_of(an, at_start)
 }
 
 /// The parameters of a model with their values and defaults (the model's
@@ -124,7 +124,7 @@ fn culprit(
         if value == default {
             continue;
         }
-        let mut m = *model;
+        let mut m = model.clone();
         if m.set(name, default).is_err() || m.validate().is_err() {
             continue;
         }
@@ -150,7 +150,7 @@ fn scaling_law(model: &AnyModel) -> String {
         if value == 0.0 {
             continue;
         }
-        let mut m = *model;
+        let mut m = model.clone();
         if m.set(name, value * 1.01).is_err() || m.validate().is_err() {
             continue;
         }

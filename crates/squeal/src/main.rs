@@ -7,6 +7,7 @@
 mod analysis;
 mod commands;
 mod feasible;
+mod lumped_file;
 mod model;
 mod out;
 mod output;
@@ -50,6 +51,12 @@ enum Command {
     Map(commands::map::MapArgs),
     /// Locate the parameter value where steady sliding changes stability.
     Critical(commands::critical::CriticalArgs),
+    /// The limit cycle a scenario settles on: period, Floquet multipliers, amplitudes, events.
+    Cycle(commands::cycle::CycleArgs),
+    /// Follow the limit cycle in one parameter: branch.csv, bifurcations, diagram.
+    Branch(commands::branch::BranchArgs),
+    /// Every eigenvalue along a one-parameter sweep, modes tracked: sweep.csv and the mode-coupling diagram.
+    Sweep(commands::sweep::SweepArgs),
     /// Re-do the thesis: 40 sets, Appendix A, the seven conclusions checked, a report.
     Reproduce(commands::reproduce::ReproduceArgs),
     /// Redraw the pictures of a saved run without re-simulating.
@@ -77,7 +84,10 @@ fn main() -> ExitCode {
         Command::Stability(a) => commands::stability::run(a),
         Command::Map(a) => commands::map::run(a),
         Command::Critical(a) => commands::critical::run(a),
+        Command::Sweep(a) => commands::sweep::run(a),
         Command::Listen(a) => commands::listen::run(a),
+        Command::Cycle(a) => commands::cycle::run(a),
+        Command::Branch(a) => commands::branch::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

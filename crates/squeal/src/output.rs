@@ -69,14 +69,19 @@ pub fn write_series_npy(run: &Run, path: &Path) -> Result<(), RunError> {
     res.map_err(|e| io_err(path, e))
 }
 
-/// Write `events.csv` with columns `t,kind`.
+/// Write `events.csv` with columns `t,kind,contact` (the contact's name).
 pub fn write_events_csv(run: &Run, path: &Path) -> Result<(), RunError> {
     let f = std::fs::File::create(path).map_err(|e| io_err(path, e))?;
     let mut w = BufWriter::new(f);
     let res = (|| -> std::io::Result<()> {
-        writeln!(w, "t,kind")?;
-        for (t, k) in &run.events {
-            writeln!(w, "{t:e},{}", k.as_str())?;
+        writeln!(w, "t,kind,contact")?;
+        for (i, (t, k)) in run.events.iter().enumerate() {
+            let c = run
+                .event_contacts
+                .get(i)
+                .and_then(|c| run.contact_names.get(*c))
+                .map_or("", String::as_str);
+            writeln!(w, "{t:e},{},{c}", k.as_str())?;
         }
         w.flush()
     })();
@@ -283,13 +288,26 @@ pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
         )));
     }
     let mut events = Vec::new();
+    let mut event_contacts = Vec::new();
+    let mut contact_names: Vec<String> = Vec::new();
     if let Ok(text) = std::fs::read_to_string(dir.join("events.csv")) {
         for line in text.lines().skip(1) {
-            if let Some((t, k)) = line.split_once(',') {
-                let kind = EventKind::ALL.into_iter().find(|e| e.as_str() == k.trim());
-                if let (Ok(t), Some(kind)) = (t.parse::<f64>(), kind) {
-                    events.push((t, kind));
-                }
+            let mut cols = line.split(',');
+            let (Some(t), Some(k)) = (cols.next(), cols.next()) else {
+                continue;
+            };
+            let kind = EventKind::ALL.into_iter().find(|e| e.as_str() == k.trim());
+            if let (Ok(t), Some(kind)) = (t.parse::<f64>(), kind) {
+                events.push((t, kind));
+                let c = cols.next().unwrap_or("").trim().to_string();
+                let i = contact_names
+                    .iter()
+                    .position(|n| *n == c)
+                    .unwrap_or_else(|| {
+                        contact_names.push(c);
+                        contact_names.len() - 1
+                    });
+                event_contacts.push(i);
             }
         }
     }
@@ -298,6 +316,8 @@ pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
         columns,
         data,
         events,
+        event_contacts,
+        contact_names,
         info: squeal_core::RunInfo {
             stats: Default::default(),
             t_final,

@@ -1,13 +1,14 @@
 //! Running a scenario: integrate and collect columns and events (outputs
 //! are staged by [`crate::staging::Staging`], re-exported here).
 
+use crate::model::observe_all;
 use crate::model::AnyModel;
 use crate::scenario::{InputError, Scenario};
-use crate::with_model;
 use indicatif::{ProgressBar, ProgressStyle};
 use squeal_core::initial::initial_state;
 use squeal_core::integrate::{Flow, Sink};
-use squeal_core::{simulate, EventKind, Mode, Model, RunInfo};
+use squeal_core::model::{Modes, Observables};
+use squeal_core::{simulate, EventKind, Mode, RunInfo, System};
 use std::io::IsTerminal;
 
 pub use crate::staging::Staging;
@@ -36,6 +37,10 @@ pub struct Run {
     pub data: Vec<Vec<f64>>,
     /// Events `(t, kind)` in order.
     pub events: Vec<(f64, EventKind)>,
+    /// The contact of each event (index into `contact_names`).
+    pub event_contacts: Vec<usize>,
+    /// Names of the model's contacts.
+    pub contact_names: Vec<String>,
     /// Integrator statistics and end time.
     pub info: RunInfo,
     /// Wall time of the integration (s).
@@ -58,25 +63,30 @@ impl Run {
     }
 }
 
-struct Collect<'a, M> {
+struct Collect<'a, M: ?Sized> {
     model: &'a M,
     any: &'a AnyModel,
     data: Vec<Vec<f64>>,
     derived: Vec<f64>,
+    obs: Vec<Observables>,
     events: Vec<(f64, EventKind)>,
+    event_contacts: Vec<usize>,
     progress: &'a ProgressBar,
     t_end: f64,
     next_tick: f64,
 }
 
-impl<M: Model<N>, const N: usize> Sink<N> for Collect<'_, M> {
+impl<M: System<N> + ?Sized, const N: usize> Sink<N> for Collect<'_, M> {
     fn sample(&mut self, t: f64, z: &[f64; N], mode: Mode) -> Flow {
+        self.sample_modes(t, z, &Modes::single(mode))
+    }
+    fn sample_modes(&mut self, t: f64, z: &[f64; N], modes: &Modes) -> Flow {
         self.data[0].push(t);
         for i in 0..N {
             self.data[1 + i].push(z[i]);
         }
-        let obs = self.model.observe(t, mode, z);
-        self.any.derived_values(&obs, mode, &mut self.derived);
+        observe_all(self.model, t, modes, z, &mut self.obs);
+        self.any.derived_values(&self.obs, modes, &mut self.derived);
         for (j, v) in self.derived.iter().enumerate() {
             self.data[1 + N + j].push(*v);
         }
@@ -88,6 +98,18 @@ impl<M: Model<N>, const N: usize> Sink<N> for Collect<'_, M> {
     }
     fn event(&mut self, t: f64, kind: EventKind, _z: &[f64; N], _mode: Mode) {
         self.events.push((t, kind));
+        self.event_contacts.push(0);
+    }
+    fn contact_event(
+        &mut self,
+        t: f64,
+        kind: EventKind,
+        contact: usize,
+        _z: &[f64; N],
+        _m: &Modes,
+    ) {
+        self.events.push((t, kind));
+        self.event_contacts.push(contact);
     }
 }
 
@@ -109,7 +131,7 @@ pub fn progress_bar(len: u64, what: &str) -> ProgressBar {
 }
 
 /// The scenario's initial state (`rest` or `equilibrium`, plus its offsets).
-pub fn initial_of<M: Model<N>, const N: usize>(
+pub fn initial_of<M: System<N> + ?Sized, const N: usize>(
     model: &M,
     sc: &Scenario,
 ) -> Result<[f64; N], RunError> {
@@ -123,7 +145,7 @@ pub fn initial_of<M: Model<N>, const N: usize>(
     })
 }
 
-fn run_model<M: Model<N>, const N: usize>(
+fn run_model<M: System<N> + ?Sized, const N: usize>(
     model: &M,
     any: &AnyModel,
     sc: &Scenario,
@@ -131,8 +153,8 @@ fn run_model<M: Model<N>, const N: usize>(
 ) -> Result<Run, RunError> {
     let z0 = initial_of(model, sc)?;
     let mut columns = vec!["t".to_string()];
-    columns.extend(model.state_names().iter().map(|s| s.to_string()));
-    columns.extend(any.derived_columns().iter().map(|s| s.to_string()));
+    columns.extend(model.names());
+    columns.extend(any.derived_columns());
     let expected = (sc.duration * sc.sample_rate) as usize + 2;
     let mut sink = Collect {
         model,
@@ -141,7 +163,9 @@ fn run_model<M: Model<N>, const N: usize>(
             .map(|_| Vec::with_capacity(expected))
             .collect(),
         derived: Vec::with_capacity(8),
+        obs: Vec::with_capacity(model.contacts()),
         events: Vec::new(),
+        event_contacts: Vec::new(),
         progress,
         t_end: sc.duration,
         next_tick: 0.0,
@@ -163,6 +187,10 @@ fn run_model<M: Model<N>, const N: usize>(
         columns,
         data: sink.data,
         events: sink.events,
+        event_contacts: sink.event_contacts,
+        contact_names: (0..model.contacts())
+            .map(|i| model.contact_name(i).to_string())
+            .collect(),
         info,
         integrate_s,
         sample_rate: sc.sample_rate,
@@ -191,5 +219,6 @@ pub fn run(sc: &Scenario) -> Result<Run, RunError> {
 
 /// Integrate a scenario, reporting progress to `pb` (hidden for sweeps).
 pub fn run_with(sc: &Scenario, pb: &ProgressBar) -> Result<Run, RunError> {
-    with_model!(&sc.model, m => run_model(m, &sc.model, sc, pb))
+    crate::with_system!(&sc.model, m => run_model(m, &sc.model, sc, pb),
+        else => Err(RunError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))))
 }

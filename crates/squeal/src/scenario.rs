@@ -5,6 +5,7 @@
 //! Raw input (TOML tables, `--set` strings) is validated into a resolved
 //! [`Scenario`] before anything runs; every error names its key and value.
 
+use crate::lumped_file::{MatrixFiles, LUMPED_KEYS};
 use crate::model::{AnyModel, MODEL_NAMES};
 use serde_json::{json, Map, Value};
 use squeal_core::friction::LAW_NAMES;
@@ -55,6 +56,8 @@ pub struct Scenario {
     pub offsets: Vec<f64>,
     /// Integrator settings.
     pub solver: SolverOptions,
+    /// A lumped model's matrix files (for `scenario show`).
+    pub matrices: MatrixFiles,
 }
 
 /// The 40 reconstructed sets of Table 11.1, embedded so that the command
@@ -111,7 +114,27 @@ pub fn thesis_sets() -> Vec<Scenario> {
 }
 
 /// Names of the built-in scenarios.
-pub const BUILTINS: [&str; 4] = ["disc-pad", "belt-coulomb", "belt", "hoffmann"];
+pub const BUILTINS: [&str; 6] = [
+    "disc-pad",
+    "belt-coulomb",
+    "belt",
+    "hoffmann",
+    "two-pad-brake",
+    "two-pad-brake-asymmetric",
+];
+
+/// The lumped built-ins: the two-pad brake, symmetric and asymmetric (the
+/// files of `scenarios/lumped/`, embedded).
+pub const LUMPED_BUILTINS: [(&str, &str); 2] = [
+    (
+        "two-pad-brake",
+        include_str!("../../../scenarios/lumped/two-pad-brake.toml"),
+    ),
+    (
+        "two-pad-brake-asymmetric",
+        include_str!("../../../scenarios/lumped/two-pad-brake-asymmetric.toml"),
+    ),
+];
 
 impl Scenario {
     /// A built-in scenario by name.
@@ -126,6 +149,7 @@ impl Scenario {
             validity: VALIDITY,
             initial: Initial::Rest,
             solver: SolverOptions::default(),
+            matrices: MatrixFiles::default(),
         };
         if let Some(n) = name
             .strip_prefix("thesis-")
@@ -134,6 +158,11 @@ impl Scenario {
             return (1..=40).contains(&n).then(|| {
                 Scenario::from_toml(THESIS_SETS[n - 1]).expect("the shipped thesis sets are valid")
             });
+        }
+        if let Some((_, text)) = LUMPED_BUILTINS.iter().find(|(n, _)| *n == name) {
+            return Some(
+                Scenario::from_toml(text).expect("the shipped lumped scenarios are valid"),
+            );
         }
         Some(match name {
             "disc-pad" => {
@@ -216,8 +245,8 @@ impl Scenario {
                     "scenario file {spec}: larger than 1 MiB; not a scenario"
                 ));
             }
-            let mut sc =
-                Scenario::from_toml(&text).map_err(|e| InputError(format!("{spec}: {}", e.0)))?;
+            let mut sc = Scenario::from_toml_in(&text, path.parent())
+                .map_err(|e| InputError(format!("{spec}: {}", e.0)))?;
             // A file without a `name` is named after itself (out/<file stem>).
             let named = text
                 .parse::<toml::Table>()
@@ -241,6 +270,12 @@ impl Scenario {
 
     /// Parse a scenario from TOML text (see `squeal scenario show`).
     pub fn from_toml(text: &str) -> Result<Scenario, InputError> {
+        Scenario::from_toml_in(text, None)
+    }
+
+    /// Parse a scenario from TOML text whose matrix files (lumped models)
+    /// are relative to `base`.
+    pub fn from_toml_in(text: &str, base: Option<&Path>) -> Result<Scenario, InputError> {
         let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
             let line = e
                 .span()
@@ -261,12 +296,20 @@ impl Scenario {
             }
             None => "disc-pad".to_string(),
         };
-        let model = AnyModel::by_name(&model_name).ok_or_else(|| {
-            InputError(format!(
-                "model = '{model_name}': expected one of {}",
-                MODEL_NAMES.join(", ")
-            ))
-        })?;
+        let mut matrices = MatrixFiles::default();
+        let lumped = model_name == "lumped";
+        let model = if lumped {
+            let (l, files) = crate::lumped_file::parse(&table, base)?;
+            matrices = files;
+            AnyModel::Lumped(Box::new(l))
+        } else {
+            AnyModel::by_name(&model_name).ok_or_else(|| {
+                InputError(format!(
+                    "model = '{model_name}': expected one of {}",
+                    MODEL_NAMES.join(", ")
+                ))
+            })?
+        };
         let mut s = Scenario {
             name: "scenario".into(),
             description: String::new(),
@@ -277,6 +320,7 @@ impl Scenario {
             validity: VALIDITY,
             initial: Initial::Rest,
             solver: SolverOptions::default(),
+            matrices,
         };
         // The friction law first, so that its parameters can follow in any order.
         if let Some(toml::Value::Table(f)) = table.get("friction") {
@@ -290,6 +334,12 @@ impl Scenario {
         for (key, value) in &table {
             match (key.as_str(), value) {
                 ("model", _) => {}
+                (k, _) if lumped && LUMPED_KEYS.contains(&k) => {}
+                ("params" | "friction", _) if lumped => {
+                    return err(format!(
+                        "{key}: a lumped model takes its parameters in its elements ([[spring]], [[contact]], …)"
+                    ))
+                }
                 ("name", toml::Value::String(v)) => {
                     check_name(v)?;
                     s.name = v.clone();
@@ -364,12 +414,18 @@ impl Scenario {
                 return err("model cannot be changed by --set: choose a scenario of that model")
             }
             _ => {
+                if let AnyModel::Lumped(l) = &self.model {
+                    return err(format!(
+                        "unknown key '{key}' for this lumped model (keys: {} …; see `squeal scenario show`)",
+                        l.keys().iter().take(6).map(|k| k.0.clone()).collect::<Vec<_>>().join(", ")
+                    ));
+                }
                 return err(format!(
                     "unknown key '{key}' for model {} with the {} friction law; {}",
                     self.model.name(),
                     self.model.friction().name(),
                     suggest(key, &self.known_keys())
-                ))
+                ));
             }
         };
         self.apply_in(section, key, value)
@@ -552,7 +608,9 @@ impl Scenario {
             }
             ("params" | "friction", k) => {
                 let x = number(value)?;
-                let known = if section == "friction" {
+                let known = if let AnyModel::Lumped(l) = &self.model {
+                    l.get(k).is_some()
+                } else if section == "friction" {
                     self.model.friction().get(k).is_some()
                 } else {
                     self.model.param_specs().iter().any(|p| p.name == k)
@@ -615,6 +673,14 @@ impl Scenario {
         friction.insert("law".into(), json!(law.name()));
         for spec in law.params() {
             friction.insert(spec.name.into(), json!(law.get(spec.name)));
+        }
+        if let AnyModel::Lumped(l) = &self.model {
+            params = l.keys().into_iter().map(|(k, v)| (k, json!(v))).collect();
+            friction = l
+                .contacts
+                .iter()
+                .map(|c| (c.name.clone(), json!(c.friction.name())))
+                .collect();
         }
         let mut offsets = Map::new();
         for (n, v) in self.model.state_names().iter().zip(&self.offsets) {
@@ -716,6 +782,11 @@ impl Scenario {
                 "unilateral (pad may lift off) | bilateral",
             );
         }
+        if let AnyModel::Lumped(l) = &self.model {
+            let _ = writeln!(t, "{}", crate::lumped_file::to_toml(l, &self.matrices));
+            self.write_offsets_solver(&mut t);
+            return t;
+        }
         let _ = writeln!(t, "\n[params]");
         for spec in self.model.param_specs() {
             let v = self.model.get(spec.name).unwrap_or(f64::NAN);
@@ -740,6 +811,15 @@ impl Scenario {
                 &format!("{}, {}", spec.unit, spec.doc),
             );
         }
+        self.write_offsets_solver(&mut t);
+        t
+    }
+
+    /// The `[offsets]` and `[solver]` tables of [`Self::to_toml`].
+    fn write_offsets_solver(&self, t: &mut String) {
+        let line = |t: &mut String, kv: String, comment: &str| {
+            let _ = writeln!(t, "{kv:<34}# {comment}");
+        };
         let _ = writeln!(
             t,
             "\n[offsets]                         # added to the initial state"
@@ -753,24 +833,24 @@ impl Scenario {
             .enumerate()
         {
             let unit = if i < n / 2 { "m" } else { "m/s" };
-            line(&mut t, format!("{name}0 = {v:?}"), unit);
+            line(t, format!("{name}0 = {v:?}"), unit);
         }
         let _ = writeln!(t, "\n[solver]");
         line(
-            &mut t,
+            t,
             format!("rtol = {:?}", self.solver.rtol),
             "relative tolerance",
         );
         if let Some(a) = self.solver.atol_pos {
             line(
-                &mut t,
+                t,
                 format!("atol_pos = {a:?}"),
                 "m, absolute tolerance of positions",
             );
         }
         if let Some(a) = self.solver.atol_vel {
             line(
-                &mut t,
+                t,
                 format!("atol_vel = {a:?}"),
                 "m/s, absolute tolerance of velocities",
             );
@@ -778,7 +858,7 @@ impl Scenario {
         for (name, a) in self.model.state_names().iter().zip(&self.solver.atol_state) {
             if let Some(a) = a {
                 line(
-                    &mut t,
+                    t,
                     format!("atol_{name} = {a:?}"),
                     "absolute tolerance of this state alone",
                 );
@@ -786,7 +866,7 @@ impl Scenario {
         }
         if self.solver.h_max.is_finite() {
             line(
-                &mut t,
+                t,
                 format!("h_max = {:?}", self.solver.h_max),
                 "s, largest step",
             );
@@ -796,7 +876,6 @@ impl Scenario {
                 "# h_max = 1e-6                    # s, largest step (default: unlimited)"
             );
         }
-        t
     }
 }
 

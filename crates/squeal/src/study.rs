@@ -18,11 +18,12 @@ use squeal_core::{EventKind, Model};
 /// dominant coordinate of each (energy-weighted).
 fn modes(m: &DiscPad) -> Option<Vec<(Complex<f64>, &'static str)>> {
     let an = stability::analyse_with_masses(m, &m.position_masses()).ok()?;
+    let names = m.state_names();
     let mut v: Vec<(Complex<f64>, &'static str)> = an
         .eigen
         .iter()
         .filter(|e| e.im >= 0.0)
-        .map(|e| (Complex::new(e.re, e.im), e.dominant_name))
+        .map(|e| (Complex::new(e.re, e.im), names[e.dominant]))
         .collect();
     v.sort_by(|a, b| a.0.im.total_cmp(&b.0.im));
     Some(v)

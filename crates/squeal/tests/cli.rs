@@ -54,7 +54,7 @@ fn default_run_writes_the_documented_outputs() {
     assert_eq!(second[11], 1.0, "v_rel = V at rest");
     assert_eq!(
         read(dir.join("events.csv")).lines().next().unwrap(),
-        "t,kind"
+        "t,kind,contact"
     );
     let summary: serde_json::Value = serde_json::from_str(&read(dir.join("summary.json"))).unwrap();
     for key in [

@@ -17,7 +17,7 @@ pub mod budget;
 pub mod roots;
 mod tableau;
 
-use crate::model::{EventKind, Guards, Mode, Model};
+use crate::model::{EventKind, Guard, GuardKind, Guards, Mode, Modes, System};
 use tableau::{A, B, C, D, E3, E5};
 
 /// Tuning knobs of the integrator. Times in seconds.
@@ -123,8 +123,10 @@ pub struct Stats {
     pub rhs_evals: u64,
     /// Events per kind, indexed by [`EventKind::index`].
     pub events: [u64; 5],
-    /// Time spent in each mode (s), indexed by [`Mode::index`].
+    /// Time spent in each mode (s) by the first contact, indexed by [`Mode::index`].
     pub mode_time: [f64; 4],
+    /// Time spent sticking (s), per contact.
+    pub stick_time: [f64; crate::model::MAX_CONTACTS],
 }
 
 impl Stats {
@@ -151,10 +153,14 @@ pub struct Segment {
     pub t0: f64,
     /// End time.
     pub t1: f64,
-    /// Mode on the segment.
+    /// Mode of the first contact on the segment.
     pub mode: Mode,
+    /// Modes of all contacts on the segment.
+    pub modes: Modes,
     /// The event that ended the segment, if any (reported kind).
     pub event: Option<EventKind>,
+    /// The contact of that event.
+    pub contact: usize,
     /// Whether the mode changed at `t1` (also for unreported transitions).
     pub switched: bool,
 }
@@ -174,10 +180,35 @@ pub trait Sink<const N: usize> {
     fn sample(&mut self, t: f64, z: &[f64; N], mode: Mode) -> Flow;
     /// An event at `t`; `z` is the state there and `mode` the mode after it.
     fn event(&mut self, _t: f64, _kind: EventKind, _z: &[f64; N], _mode: Mode) {}
+    /// A sample with the modes of every contact (default: [`Sink::sample`]
+    /// with the first contact's mode).
+    #[inline]
+    fn sample_modes(&mut self, t: f64, z: &[f64; N], modes: &Modes) -> Flow {
+        self.sample(t, z, modes.first())
+    }
+    /// An event of contact `contact` (default: [`Sink::event`] with the
+    /// first contact's mode).
+    fn contact_event(
+        &mut self,
+        t: f64,
+        kind: EventKind,
+        _contact: usize,
+        z: &[f64; N],
+        modes: &Modes,
+    ) {
+        self.event(t, kind, z, modes.first())
+    }
 }
 
+/// An event fired while settling a mode: kind, contact, state, modes after it.
+type Pending<const N: usize> = (EventKind, usize, [f64; N], Modes);
+
+/// Most guard evaluations of the Lipschitz search on one step before the
+/// step is retried at a quarter of its size.
+const LIPSCHITZ_EVALS: usize = 256;
+
 /// DOP853 stepper with event location, for one model.
-pub struct Solver<'m, M: Model<N>, const N: usize> {
+pub struct Solver<'m, M: System<N> + ?Sized, const N: usize> {
     model: &'m M,
     opts: SolverOptions,
     atol: [f64; N],
@@ -185,7 +216,7 @@ pub struct Solver<'m, M: Model<N>, const N: usize> {
     t_end: f64,
     z: [f64; N],
     f: [f64; N],
-    mode: Mode,
+    modes: Modes,
     h: f64,
     last_rejected: bool,
     err_old: f64,
@@ -200,7 +231,7 @@ pub struct Solver<'m, M: Model<N>, const N: usize> {
     last_event_t: f64,
     zeno_run: u32,
     /// Events fired while settling a mode (at most [`SETTLE_LIMIT`]), oldest first.
-    pending: [(EventKind, [f64; N], Mode); SETTLE_LIMIT],
+    pending: [Pending<N>; SETTLE_LIMIT],
     pending_len: usize,
     pending_next: usize,
 }
@@ -211,7 +242,7 @@ pub const DEFAULT_ATOL_POS: f64 = 1e-16;
 /// See [`DEFAULT_ATOL_POS`].
 pub const DEFAULT_ATOL_VEL: f64 = 1e-11;
 
-impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
+impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
     /// A solver at `(t0, z0)` integrating to `t_end`. The initial mode is
     /// the model's; it is settled at once (a guard already violated fires).
     pub fn new(
@@ -261,7 +292,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
             };
             atol[i] = opts.atol_state.get(i).copied().flatten().unwrap_or(by_kind);
         }
-        let mode = model.initial_mode(t0, &z0);
+        let modes = model.start_modes(t0, &z0);
         let mut s = Solver {
             model,
             opts,
@@ -270,7 +301,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
             t_end,
             z: z0,
             f: [0.0; N],
-            mode,
+            modes,
             h: 0.0,
             last_rejected: false,
             err_old: 1e-4,
@@ -283,11 +314,11 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
             stats: Stats::default(),
             last_event_t: f64::NEG_INFINITY,
             zeno_run: 0,
-            pending: [(EventKind::Stick, [0.0; N], Mode::Free); SETTLE_LIMIT],
+            pending: [(EventKind::Stick, 0, [0.0; N], modes); SETTLE_LIMIT],
             pending_len: 0,
             pending_next: 0,
         };
-        s.enter_mode(mode)?;
+        s.enter_mode(modes)?;
         s.h = match opts.h_init {
             Some(h) if h > 0.0 => h,
             _ => s.initial_step(),
@@ -303,9 +334,13 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
     pub fn state(&self) -> &[f64; N] {
         &self.z
     }
-    /// Current mode.
+    /// Current mode of the first contact.
     pub fn mode(&self) -> Mode {
-        self.mode
+        self.modes.first()
+    }
+    /// Current modes of all contacts.
+    pub fn modes(&self) -> Modes {
+        self.modes
     }
     /// Statistics so far.
     pub fn stats(&self) -> &Stats {
@@ -318,6 +353,12 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
     /// The events the solver fired while settling the mode at the start or
     /// after the last transition, oldest first, each reported once.
     pub fn take_pending_event(&mut self) -> Option<(EventKind, [f64; N], Mode)> {
+        self.take_pending_contact_event()
+            .map(|(k, _, z, m)| (k, z, m.first()))
+    }
+
+    /// As [`Self::take_pending_event`], with the contact and every contact's mode.
+    pub fn take_pending_contact_event(&mut self) -> Option<Pending<N>> {
         if self.pending_next < self.pending_len {
             self.pending_next += 1;
             Some(self.pending[self.pending_next - 1])
@@ -327,54 +368,82 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
     }
 
     #[inline]
-    fn rhs(&mut self, t: f64, mode: Mode, z: &[f64; N], dz: &mut [f64; N]) {
+    fn rhs(&mut self, t: f64, modes: Modes, z: &[f64; N], dz: &mut [f64; N]) {
         self.stats.rhs_evals += 1;
-        self.model.rhs(t, mode, z, dz);
+        self.model.field(t, &modes, z, dz);
     }
 
-    /// Switch to `mode` at the current state: load its guards, evaluate f,
-    /// and fire at once any guard that is already on its surface and moving out
-    /// (a mode that is left as soon as it is entered).
-    fn enter_mode(&mut self, mut mode: Mode) -> Result<(), IntegrateError> {
+    /// Switch to `modes` at the current state: load their guards, evaluate
+    /// f, and fire at once any guard that is already on its surface and moving
+    /// out, or clearly beyond it (a mode that is left as soon as it is entered;
+    /// with several contacts, one contact's transition can release another's
+    /// stick at the same instant). Guards are tried in order, so simultaneous
+    /// transitions resolve deterministically, lowest contact first.
+    fn enter_mode(&mut self, mut modes: Modes) -> Result<(), IntegrateError> {
         for _ in 0..SETTLE_LIMIT {
-            self.mode = mode;
-            self.model.guards(mode, &mut self.guards);
+            self.modes = modes;
+            self.model.mode_guards(&modes, &mut self.guards);
             let (t, z) = (self.t, self.z);
             let mut f = [0.0; N];
-            self.rhs(t, mode, &z, &mut f);
+            self.rhs(t, modes, &z, &mut f);
             self.f = f;
             let mut fired = None;
             for g in self.guards.as_slice() {
-                let val = g.eval(&self.z);
-                let mut rate = 0.0;
-                let mut scale = 0.0;
-                for i in 0..N {
-                    rate += g.c[i] * self.f[i];
-                    scale += (g.c[i] * self.f[i]).abs();
-                }
+                let (val, rate, scale, vscale) = if g.affine {
+                    let mut rate = 0.0;
+                    let mut scale = 0.0;
+                    let mut vscale = g.d.abs();
+                    for i in 0..N {
+                        rate += g.c[i] * self.f[i];
+                        scale += (g.c[i] * self.f[i]).abs();
+                        vscale += (g.c[i] * self.z[i]).abs();
+                    }
+                    (g.eval(&self.z), rate, scale, vscale)
+                } else {
+                    let c = self.model.guard_gradient(t, &modes, g, &z);
+                    let mut rate = 0.0;
+                    let mut scale = 0.0;
+                    let mut vscale = 0.0;
+                    for i in 0..N {
+                        rate += c[i] * self.f[i];
+                        scale += (c[i] * self.f[i]).abs();
+                        vscale += (c[i] * self.z[i]).abs();
+                    }
+                    (
+                        self.model.guard_value(t, &modes, g, &z),
+                        rate,
+                        scale,
+                        vscale,
+                    )
+                };
                 // Leaving at once needs a rate clearly above round-off: at a
                 // smooth stick→slip transition (μ(0+) = μ_s) the rate is zero
-                // and the sign of round-off must not decide.
-                if val >= 0.0 && rate > 1e-9 * scale {
-                    fired = Some(g.kind);
+                // and the sign of round-off must not decide. A stick bound
+                // clearly exceeded (beyond round-off of its terms: another
+                // contact's transition changed this one's multiplier) fires
+                // whatever its rate.
+                let stick_break =
+                    matches!(g.kind, GuardKind::StickBreakPos | GuardKind::StickBreakNeg);
+                if (val >= 0.0 && rate > 1e-9 * scale) || (stick_break && val > 1e-9 * vscale) {
+                    fired = Some(*g);
                     break;
                 }
             }
-            let Some(kind) = fired else { return Ok(()) };
+            let Some(g) = fired else { return Ok(()) };
             let mut z = self.z;
-            let (next, ev) = self.model.transition(self.t, mode, kind, &mut z);
+            let (next, ev) = self.model.switch(self.t, &modes, &g, &mut z);
             self.z = z;
             if let Some(ev) = ev {
                 self.note_event(ev)?;
                 if self.pending_len < SETTLE_LIMIT {
-                    self.pending[self.pending_len] = (ev, self.z, next);
+                    self.pending[self.pending_len] = (ev, g.contact as usize, self.z, next);
                     self.pending_len += 1;
                 }
             }
-            if next == mode {
+            if next == modes {
                 return Ok(());
             }
-            mode = next;
+            modes = next;
         }
         Err(IntegrateError::Chatter {
             t: self.t,
@@ -403,7 +472,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
 
     /// Hairer's initial step size (Solving ODEs I, II.4).
     fn initial_step(&mut self) -> f64 {
-        let (t, z, f0, mode) = (self.t, self.z, self.f, self.mode);
+        let (t, z, f0, mode) = (self.t, self.z, self.f, self.modes);
         let mut d0 = 0.0;
         let mut d1 = 0.0;
         for i in 0..N {
@@ -457,7 +526,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
 
     /// Stage `s`: its state from the earlier stages, and its slope.
     #[inline(always)]
-    fn stage(&mut self, s: usize, t: f64, z: &[f64; N], mode: Mode, h: f64) {
+    fn stage(&mut self, s: usize, t: f64, z: &[f64; N], mode: Modes, h: f64) {
         let y = self.combine(z, &A[s], s, h);
         let mut ks = [0.0; N];
         self.rhs(t + C[s] * h, mode, &y, &mut ks);
@@ -468,7 +537,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
     /// returns the new state and the error norm.
     #[inline]
     fn rk_step(&mut self, h: f64) -> ([f64; N], f64) {
-        let (t, z, mode) = (self.t, self.z, self.mode);
+        let (t, z, mode) = (self.t, self.z, self.modes);
         self.k[0] = self.f;
         for s in 1..12 {
             self.stage(s, t, &z, mode, h);
@@ -499,7 +568,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
     /// Dense output coefficients of the accepted step (three more stages).
     #[inline]
     fn build_dense(&mut self, h: f64, z_new: &[f64; N]) {
-        let (t, z, mode) = (self.t, self.z, self.mode);
+        let (t, z, mode) = (self.t, self.z, self.modes);
         for s in 13..16 {
             self.stage(s, t, &z, mode, h);
         }
@@ -595,7 +664,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
             });
         }
         let mut t_stop = self.t_end;
-        if let Some(b) = self.model.next_breakpoint(self.t) {
+        if let Some(b) = self.model.breakpoint_after(self.t) {
             if b > self.t && b < t_stop {
                 t_stop = b;
             }
@@ -604,65 +673,87 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
         const FAC_MIN: f64 = 1.0 / 3.0; // step may shrink to a third…
         const FAC_MAX: f64 = 6.0; // …or grow sixfold
         const BETA: f64 = 0.04; // PI stabilisation (0 = the elementary controller)
-        let (z_new, h) = loop {
-            let mut h = self.h.min(self.opts.h_max);
-            let remaining = t_stop - self.t;
-            let mut hits_stop = false;
-            if h >= remaining * (1.0 - 1e-12) {
-                h = remaining;
-                hits_stop = true;
-            }
-            let h_min = 16.0 * f64::EPSILON * self.t.abs().max(1e-6);
-            if h < h_min && !hits_stop {
-                return Err(IntegrateError::StepUnderflow { t: self.t, h });
-            }
-            let (z_new, err) = self.rk_step(h);
-            if !err.is_finite() || z_new.iter().any(|x| !x.is_finite()) {
-                if h < h_min {
-                    return Err(IntegrateError::NonFinite { t: self.t });
+        let (z_new, h, first) = 'attempt: loop {
+            let (z_new, h) = loop {
+                let mut h = self.h.min(self.opts.h_max);
+                let remaining = t_stop - self.t;
+                let mut hits_stop = false;
+                if h >= remaining * (1.0 - 1e-12) {
+                    h = remaining;
+                    hits_stop = true;
+                }
+                let h_min = 16.0 * f64::EPSILON * self.t.abs().max(1e-6);
+                if h < h_min && !hits_stop {
+                    return Err(IntegrateError::StepUnderflow { t: self.t, h });
+                }
+                let (z_new, err) = self.rk_step(h);
+                if !err.is_finite() || z_new.iter().any(|x| !x.is_finite()) {
+                    if h < h_min {
+                        return Err(IntegrateError::NonFinite { t: self.t });
+                    }
+                    self.stats.rejected += 1;
+                    self.h = h * 0.1;
+                    self.last_rejected = true;
+                    continue;
+                }
+                // Proportional-integral step control (Gustafsson; Hairer–Nørsett–
+                // Wanner II.4 and the DOP853 code's BETA): the memory of the last
+                // accepted error damps the controller's oscillation on this
+                // oscillatory problem, which otherwise rejects one step in five.
+                let fac11 = err.powf(1.0 / 8.0 - 0.75 * BETA);
+                if err <= 1.0 {
+                    let fac = (fac11 / self.err_old.powf(BETA) / SAFE)
+                        .clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+                    self.err_old = err.max(1e-4);
+                    let mut h_new = h / fac;
+                    if self.last_rejected {
+                        h_new = h_new.min(h);
+                    }
+                    self.last_rejected = false;
+                    // After a step clipped to a stop, keep the unclipped proposal.
+                    self.h = if hits_stop { self.h.max(h_new) } else { h_new };
+                    break (z_new, h);
                 }
                 self.stats.rejected += 1;
-                self.h = h * 0.1;
                 self.last_rejected = true;
-                continue;
-            }
-            // Proportional-integral step control (Gustafsson; Hairer–Nørsett–
-            // Wanner II.4 and the DOP853 code's BETA): the memory of the last
-            // accepted error damps the controller's oscillation on this
-            // oscillatory problem, which otherwise rejects one step in five.
-            let fac11 = err.powf(1.0 / 8.0 - 0.75 * BETA);
-            if err <= 1.0 {
-                let fac =
-                    (fac11 / self.err_old.powf(BETA) / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-                self.err_old = err.max(1e-4);
-                let mut h_new = h / fac;
-                if self.last_rejected {
-                    h_new = h_new.min(h);
-                }
-                self.last_rejected = false;
-                // After a step clipped to a stop, keep the unclipped proposal.
-                self.h = if hits_stop { self.h.max(h_new) } else { h_new };
-                break (z_new, h);
-            }
-            self.stats.rejected += 1;
-            self.last_rejected = true;
-            self.h = h / (fac11 / SAFE).min(1.0 / FAC_MIN);
-        };
-        self.stats.accepted += 1;
-        self.build_dense(h, &z_new);
+                self.h = h / (fac11 / SAFE).min(1.0 / FAC_MIN);
+            };
+            self.stats.accepted += 1;
+            self.build_dense(h, &z_new);
 
-        // Earliest upward crossing of any guard on the step.
-        let tol = (self.opts.event_tol / h).clamp(4.0 * f64::EPSILON, 1e-9);
-        let mut first: Option<(f64, usize)> = None;
-        for (gi, g) in self.guards.as_slice().iter().enumerate() {
-            let p = self.guard_poly(&g.c, g.d);
-            if let Some(theta) = roots::first_upcrossing(&p, tol) {
-                if first.is_none_or(|(best, _)| theta < best) {
-                    first = Some((theta, gi));
+            // Earliest upward crossing of any guard on the step.
+            let tol = (self.opts.event_tol / h).clamp(4.0 * f64::EPSILON, 1e-9);
+            let mut first: Option<(f64, usize)> = None;
+            let mut bounds = None;
+            for gi in 0..self.guards.len() {
+                let g = self.guards.as_slice()[gi];
+                let found = if g.affine {
+                    let p = self.guard_poly(&g.c, g.d);
+                    roots::first_upcrossing(&p, tol)
+                } else {
+                    let b = *bounds.get_or_insert_with(|| self.step_bounds());
+                    match self.lipschitz_upcrossing(&g, h, &b, tol) {
+                        Ok(found) => found,
+                        Err(()) => {
+                            // The bound is too loose on a step this long: retry at a quarter.
+                            self.stats.accepted -= 1;
+                            self.stats.rejected += 1;
+                            self.last_rejected = true;
+                            self.h = 0.25 * h;
+                            continue 'attempt;
+                        }
+                    }
+                };
+                if let Some(theta) = found {
+                    if first.is_none_or(|(best, _)| theta < best) {
+                        first = Some((theta, gi));
+                    }
                 }
             }
-        }
-        let mode = self.mode;
+            break (z_new, h, first);
+        };
+        let modes = self.modes;
+        let mode = modes.first();
         let t0 = self.t;
         match first {
             None => {
@@ -671,7 +762,7 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
                 } else {
                     t0 + h
                 };
-                self.stats.mode_time[mode.index()] += t1 - t0;
+                self.note_time(t1 - t0);
                 self.t = t1;
                 self.z = z_new;
                 self.f = self.k[12];
@@ -679,7 +770,9 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
                     t0,
                     t1,
                     mode,
+                    modes,
                     event: None,
+                    contact: 0,
                     switched: false,
                 }))
             }
@@ -688,10 +781,10 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
                 // The state at θ itself (not at t0 + θh rounded): on the
                 // non-negative side of the guard, so the transition sees it fired.
                 let mut z = self.dense_theta(theta);
-                let kind = self.guards.as_slice()[gi].kind;
-                self.stats.mode_time[mode.index()] += t1 - t0;
+                let g = self.guards.as_slice()[gi];
+                self.note_time(t1 - t0);
                 self.t = t1;
-                let (next, ev) = self.model.transition(t1, mode, kind, &mut z);
+                let (next, ev) = self.model.switch(t1, &modes, &g, &mut z);
                 self.z = z;
                 if let Some(ev) = ev {
                     self.note_event(ev)?;
@@ -704,12 +797,117 @@ impl<'m, M: Model<N>, const N: usize> Solver<'m, M, N> {
                     t0,
                     t1,
                     mode,
+                    modes,
                     event: ev,
-                    switched: next != mode || ev.is_some(),
+                    contact: g.contact as usize,
+                    switched: next != modes || ev.is_some(),
                 }))
             }
         }
     }
+
+    /// Add `dt` to the time statistics of the current modes.
+    #[inline]
+    fn note_time(&mut self, dt: f64) {
+        self.stats.mode_time[self.modes.first().index()] += dt;
+        for (i, m) in self.modes.as_slice().iter().enumerate() {
+            if *m == Mode::Stick {
+                self.stats.stick_time[i] += dt;
+            }
+        }
+    }
+
+    /// Range `[lo, hi]` of every state over the last step, and a bound of
+    /// `|dy_i/dθ|`, from the Bernstein coefficients of the dense output (whose
+    /// convex hull contains the polynomial).
+    fn step_bounds(&self) -> StepBounds<N> {
+        let mut b = StepBounds {
+            lo: [0.0; N],
+            hi: [0.0; N],
+            rate: [0.0; N],
+        };
+        for i in 0..N {
+            let mut e = [0.0; N];
+            e[i] = 1.0;
+            let p = self.guard_poly(&e, 0.0);
+            let (lo, hi) = roots::range(&p);
+            let mut dp = [0.0; 8];
+            for k in 1..8 {
+                dp[k - 1] = k as f64 * p[k];
+            }
+            let (dlo, dhi) = roots::range(&dp);
+            // A little slack for the round-off of the conversions.
+            let pad = 1e-12 * (lo.abs().max(hi.abs()));
+            b.lo[i] = lo - pad;
+            b.hi[i] = hi + pad;
+            b.rate[i] = dlo.abs().max(dhi.abs()) * (1.0 + 1e-12);
+        }
+        b
+    }
+
+    /// First upward crossing on the last step of a guard that is not affine:
+    /// walk from θ = 0 in jumps of `|g(θ)|/L`, where `L` bounds `|dg/dθ|` on
+    /// the step ([`System::guard_slope_bound`]), so that no crossing is
+    /// stepped over (none is shorter than a jump can skip, up to the event
+    /// tolerance `tol` in θ); refine a bracketed crossing by bisection.
+    /// `Err` if the walk needs more than [`LIPSCHITZ_EVALS`] evaluations
+    /// (then the step is retried shorter).
+    fn lipschitz_upcrossing(
+        &self,
+        g: &Guard<N>,
+        h: f64,
+        b: &StepBounds<N>,
+        tol: f64,
+    ) -> Result<Option<f64>, ()> {
+        let t0 = self.t_old;
+        let modes = self.modes;
+        let value = |th: f64| {
+            let y = self.dense_theta(th);
+            self.model.guard_value(t0 + th * h, &modes, g, &y)
+        };
+        let l = self
+            .model
+            .guard_slope_bound(t0, h, &modes, g, &b.lo, &b.hi, &b.rate);
+        let l = if l.is_finite() {
+            l.max(f64::MIN_POSITIVE)
+        } else {
+            f64::INFINITY
+        };
+        let mut th = 0.0;
+        let mut gv = value(0.0);
+        for _ in 0..LIPSCHITZ_EVALS {
+            let jump = (gv.abs() / l).max(tol);
+            let next = (th + jump).min(1.0);
+            let gn = value(next);
+            if gv < 0.0 && gn >= 0.0 {
+                // Bisection on [th, next] down to tol.
+                let (mut a, mut c) = (th, next);
+                while c - a > tol {
+                    let m = 0.5 * (a + c);
+                    if value(m) >= 0.0 {
+                        c = m;
+                    } else {
+                        a = m;
+                    }
+                }
+                return Ok(Some(c));
+            }
+            if next >= 1.0 {
+                return Ok(None);
+            }
+            th = next;
+            gv = gn;
+        }
+        Err(())
+    }
+}
+
+/// Ranges of the states and of their θ-derivatives over one step.
+#[derive(Debug, Clone, Copy)]
+struct StepBounds<const N: usize> {
+    lo: [f64; N],
+    hi: [f64; N],
+    rate: [f64; N],
 }
 
 /// Run summary from [`simulate`].
@@ -725,7 +923,7 @@ pub struct RunInfo {
 
 /// Integrate `model` from `(t0, z0)` to `t_end`, feeding the sink with
 /// samples at `t0 + k/sample_rate` (k = 0, 1, …) and with every event.
-pub fn simulate<M: Model<N>, S: Sink<N>, const N: usize>(
+pub fn simulate<M: System<N> + ?Sized, S: Sink<N>, const N: usize>(
     model: &M,
     t0: f64,
     z0: [f64; N],
@@ -740,12 +938,12 @@ pub fn simulate<M: Model<N>, S: Sink<N>, const N: usize>(
         )));
     }
     let mut solver = Solver::new(model, t0, z0, t_end, opts)?;
-    while let Some((ev, z, m)) = solver.take_pending_event() {
-        sink.event(t0, ev, &z, m);
+    while let Some((ev, c, z, m)) = solver.take_pending_contact_event() {
+        sink.contact_event(t0, ev, c, &z, &m);
     }
     let dt = 1.0 / sample_rate;
     let mut k: u64 = 0;
-    if sink.sample(t0, solver.state(), solver.mode()) == Flow::Stop {
+    if sink.sample_modes(t0, solver.state(), &solver.modes()) == Flow::Stop {
         return Ok(RunInfo {
             stats: *solver.stats(),
             t_final: t0,
@@ -770,7 +968,7 @@ pub fn simulate<M: Model<N>, S: Sink<N>, const N: usize>(
             let ts = ts.min(seg.t1);
             let z = solver.dense_at(ts);
             k += 1;
-            if sink.sample(ts, &z, seg.mode) == Flow::Stop {
+            if sink.sample_modes(ts, &z, &seg.modes) == Flow::Stop {
                 return Ok(RunInfo {
                     stats: *solver.stats(),
                     t_final: ts,
@@ -779,10 +977,10 @@ pub fn simulate<M: Model<N>, S: Sink<N>, const N: usize>(
             }
         }
         if let Some(ev) = seg.event {
-            sink.event(seg.t1, ev, solver.state(), solver.mode());
+            sink.contact_event(seg.t1, ev, seg.contact, solver.state(), &solver.modes());
         }
-        while let Some((ev, z, m)) = solver.take_pending_event() {
-            sink.event(seg.t1, ev, &z, m);
+        while let Some((ev, c, z, m)) = solver.take_pending_contact_event() {
+            sink.contact_event(seg.t1, ev, c, &z, &m);
         }
     }
     Ok(RunInfo {

@@ -49,6 +49,17 @@ pub fn horner(a: &[f64; NC], x: f64) -> f64 {
     s
 }
 
+/// An enclosure `[lo, hi]` of a power-basis polynomial's values on
+/// `θ ∈ [0, 1]`: the extreme Bernstein coefficients (the polynomial lies in
+/// their convex hull).
+pub fn range(a: &[f64; NC]) -> (f64, f64) {
+    let b = to_bernstein(a);
+    b.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+            (lo.min(*x), hi.max(*x))
+        })
+}
+
 /// Bernstein coefficients on [0, 1] of a power-basis polynomial.
 #[inline]
 pub fn to_bernstein(a: &[f64; NC]) -> [f64; NC] {

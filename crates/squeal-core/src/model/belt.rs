@@ -105,6 +105,10 @@ impl Model<2> for Belt {
     fn name(&self) -> &'static str {
         "belt"
     }
+    fn interface_name(&self) -> &'static str {
+        "belt"
+    }
+
     fn state_names(&self) -> [&'static str; 2] {
         ["x", "v"]
     }

@@ -322,6 +322,10 @@ impl Model<8> for DiscPad {
         "disc-pad"
     }
 
+    fn interface_name(&self) -> &'static str {
+        "pad"
+    }
+
     fn state_names(&self) -> [&'static str; 8] {
         ["x_d", "x_p", "y_d", "y_p", "vx_d", "vx_p", "vy_d", "vy_p"]
     }

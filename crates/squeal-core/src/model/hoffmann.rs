@@ -263,6 +263,10 @@ impl Model<4> for Hoffmann {
         "hoffmann"
     }
 
+    fn interface_name(&self) -> &'static str {
+        "belt"
+    }
+
     fn state_names(&self) -> [&'static str; 4] {
         ["x", "y", "vx", "vy"]
     }

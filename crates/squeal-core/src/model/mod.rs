@@ -7,8 +7,13 @@
 //! dense output it is a polynomial whose roots can all be found (MODEL.md §8).
 
 pub mod belt;
+pub mod contact;
 pub mod disc_pad;
 pub mod hoffmann;
+pub mod lumped;
+pub mod system;
+
+pub use system::{Modes, System, MAX_CONTACTS};
 
 use crate::params::{ParamError, ParamSpec};
 
@@ -113,16 +118,23 @@ pub enum GuardKind {
     Contact,
 }
 
-/// An affine event function `g(z) = c·z + d`, negative inside the mode's
-/// domain; the event fires where `g` crosses zero upwards.
+/// An event function, negative inside the mode's domain; the event fires
+/// where it crosses zero upwards. Most guards are affine, `g(z) = c·z + d`;
+/// a guard with `affine == false` is evaluated by
+/// [`System::guard_value`] (`c`, `d` are then unused) and searched for with a
+/// Lipschitz bound ([`System::guard_slope_bound`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Guard<const N: usize> {
     /// The surface it describes.
     pub kind: GuardKind,
-    /// Gradient of g.
+    /// Gradient of g (affine guards).
     pub c: [f64; N],
-    /// Constant term of g.
+    /// Constant term of g (affine guards).
     pub d: f64,
+    /// Index of the contact the guard belongs to (0 for one-contact models).
+    pub contact: u8,
+    /// Whether `g(z) = c·z + d` exactly.
+    pub affine: bool,
 }
 
 impl<const N: usize> Guard<N> {
@@ -137,8 +149,8 @@ impl<const N: usize> Guard<N> {
     }
 }
 
-/// Most guards any mode has.
-pub const MAX_GUARDS: usize = 4;
+/// Most guards any mode has: two per contact, at most [`MAX_CONTACTS`] contacts.
+pub const MAX_GUARDS: usize = 2 * MAX_CONTACTS;
 
 /// The guards of one mode: a fixed-capacity list (no allocation).
 #[derive(Debug, Clone, Copy)]
@@ -155,6 +167,8 @@ impl<const N: usize> Default for Guards<N> {
                 kind: GuardKind::SlipZero,
                 c: [0.0; N],
                 d: 0.0,
+                contact: 0,
+                affine: true,
             }; MAX_GUARDS],
         }
     }
@@ -165,14 +179,32 @@ impl<const N: usize> Guards<N> {
     pub fn clear(&mut self) {
         self.len = 0;
     }
-    /// Add a guard.
+    /// Add an affine guard of contact 0.
     pub fn push(&mut self, kind: GuardKind, c: [f64; N], d: f64) {
+        self.push_guard(Guard {
+            kind,
+            c,
+            d,
+            contact: 0,
+            affine: true,
+        });
+    }
+    /// Add a guard.
+    pub fn push_guard(&mut self, g: Guard<N>) {
         assert!(
             self.len < MAX_GUARDS,
             "a mode has at most {MAX_GUARDS} guards"
         );
-        self.items[self.len] = Guard { kind, c, d };
+        self.items[self.len] = g;
         self.len += 1;
+    }
+    /// Number of guards.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
     }
     /// The guards as a slice.
     pub fn as_slice(&self) -> &[Guard<N>] {
@@ -228,6 +260,10 @@ pub trait Model<const N: usize>: Sync {
     ) -> (Mode, Option<EventKind>);
     /// The mode a run starts in from state `z`.
     fn initial_mode(&self, t: f64, z: &[f64; N]) -> Mode;
+    /// Name of the frictional interface (`events.csv`'s `contact` column).
+    fn interface_name(&self) -> &'static str {
+        "contact"
+    }
     /// Interface forces and sliding velocity.
     fn observe(&self, t: f64, mode: Mode, z: &[f64; N]) -> Observables;
     /// The next time after `t` at which the vector field has a kink in time

@@ -35,10 +35,18 @@ use nalgebra::Complex;
 
 /// Most sweeps of [`balance`] (it converges in a handful; this only bounds
 /// the loop on pathological input).
-const MAX_BALANCE_SWEEPS: usize = 200;
+pub const MAX_BALANCE_SWEEPS: usize = 200;
 
 /// QR iterations allowed per eigenvalue in [`hqr`] before it gives up.
 pub const MAX_QR_ITERATIONS: usize = 60;
+
+// Every algorithm below is written once, on a row-major `n × n` slice
+// (`a[i * n + j]`), and used twice: by the fixed-size wrappers (`N` known at
+// compile time, stack arrays, no heap allocation; `#[inline(always)]` lets the
+// compiler fold `n = N`) and by the runtime-sized [`Workspace`] used for
+// models whose size is known only at run time
+// ([`analyse_matrix`](super::modal::analyse_matrix)). Both paths perform the
+// same floating-point operations in the same order, so they agree bit for bit.
 
 /// Parlett–Reinsch balancing with radix 2 (EISPACK `balanc`, 1-norms of the
 /// off-diagonal parts of row and column `i`): overwrites `a` by `D⁻¹ a D` and
@@ -46,18 +54,28 @@ pub const MAX_QR_ITERATIONS: usize = 60;
 /// of the balanced matrix is `x = D x̃` for the original one. Every scale is
 /// a power of two, so the similarity is exact. `a` must be finite.
 pub fn balance<const N: usize>(a: &mut [[f64; N]; N]) -> [f64; N] {
+    let mut d = [1.0; N];
+    balance_flat(a.as_flattened_mut(), N, &mut d);
+    d
+}
+
+/// [`balance`] on a row-major `n × n` slice; `d` (length `n`) receives the
+/// diagonal of `D`.
+#[inline(always)]
+pub fn balance_flat(a: &mut [f64], n: usize, d: &mut [f64]) {
     const RADIX: f64 = 2.0;
     const SQRDX: f64 = RADIX * RADIX;
-    let mut d = [1.0; N];
+    assert!(a.len() == n * n && d.len() == n);
+    d.fill(1.0);
     for _ in 0..MAX_BALANCE_SWEEPS {
         let mut done = true;
-        for i in 0..N {
+        for i in 0..n {
             let mut c = 0.0;
             let mut r = 0.0;
-            for j in 0..N {
+            for j in 0..n {
                 if j != i {
-                    c += a[j][i].abs();
-                    r += a[i][j].abs();
+                    c += a[j * n + i].abs();
+                    r += a[i * n + j].abs();
                 }
             }
             // A zero row or column needs no scaling; a non-finite sum (an
@@ -82,11 +100,11 @@ pub fn balance<const N: usize>(a: &mut [[f64; N]; N]) -> [f64; N] {
                 done = false;
                 let gi = 1.0 / f;
                 d[i] *= f;
-                for j in 0..N {
-                    a[i][j] *= gi;
+                for j in 0..n {
+                    a[i * n + j] *= gi;
                 }
-                for j in 0..N {
-                    a[j][i] *= f;
+                for j in 0..n {
+                    a[j * n + i] *= f;
                 }
             }
         }
@@ -94,7 +112,6 @@ pub fn balance<const N: usize>(a: &mut [[f64; N]; N]) -> [f64; N] {
             break;
         }
     }
-    d
 }
 
 /// Householder reduction of `a` to upper Hessenberg form in place (EISPACK
@@ -102,43 +119,50 @@ pub fn balance<const N: usize>(a: &mut [[f64; N]; N]) -> [f64; N] {
 /// first subdiagonal are set to exactly zero.
 pub fn hessenberg<const N: usize>(a: &mut [[f64; N]; N]) {
     let mut v = [0.0; N];
-    for k in 0..N.saturating_sub(2) {
-        let scale: f64 = (k + 1..N).map(|i| a[i][k].abs()).sum();
+    hessenberg_flat(a.as_flattened_mut(), N, &mut v);
+}
+
+/// [`hessenberg`] on a row-major `n × n` slice, with scratch `v` (length `n`).
+#[inline(always)]
+pub fn hessenberg_flat(a: &mut [f64], n: usize, v: &mut [f64]) {
+    assert!(a.len() == n * n && v.len() == n);
+    for k in 0..n.saturating_sub(2) {
+        let scale: f64 = (k + 1..n).map(|i| a[i * n + k].abs()).sum();
         if scale == 0.0 {
             continue;
         }
         let mut h = 0.0;
-        for i in k + 1..N {
-            v[i] = a[i][k] / scale;
+        for i in k + 1..n {
+            v[i] = a[i * n + k] / scale;
             h += v[i] * v[i];
         }
         let g = -v[k + 1].signum() * h.sqrt();
         h -= v[k + 1] * g;
         v[k + 1] -= g;
         // P = I − v vᵀ / h, applied from the left (rows k+1..) ...
-        for j in k + 1..N {
+        for j in k + 1..n {
             let mut f = 0.0;
-            for i in k + 1..N {
-                f += v[i] * a[i][j];
+            for i in k + 1..n {
+                f += v[i] * a[i * n + j];
             }
             f /= h;
-            for i in k + 1..N {
-                a[i][j] -= f * v[i];
+            for i in k + 1..n {
+                a[i * n + j] -= f * v[i];
             }
         }
         // ... and from the right (columns k+1..).
-        for row in a.iter_mut() {
+        for row in a.chunks_exact_mut(n) {
             let mut f = 0.0;
-            for j in k + 1..N {
+            for j in k + 1..n {
                 f += row[j] * v[j];
             }
             f /= h;
-            for j in k + 1..N {
+            for j in k + 1..n {
                 row[j] -= f * v[j];
             }
         }
-        a[k + 1][k] = scale * g;
-        for row in a.iter_mut().skip(k + 2) {
+        a[(k + 1) * n + k] = scale * g;
+        for row in a.chunks_exact_mut(n).skip(k + 2) {
             row[k] = 0.0;
         }
     }
@@ -164,15 +188,23 @@ fn sign(a: f64, b: f64) -> f64 {
 /// Returns `None` if an eigenvalue needs more than [`MAX_QR_ITERATIONS`]
 /// iterations (or the input is not finite).
 pub fn hqr<const N: usize>(h: &mut [[f64; N]; N]) -> Option<[Complex<f64>; N]> {
+    let mut out = [Complex::new(0.0, 0.0); N];
+    hqr_flat(h.as_flattened_mut(), N, &mut out).then_some(out)
+}
+
+/// [`hqr`] on a row-major `n × n` slice; the eigenvalues go to `out` (length
+/// `n`). Returns `false` where [`hqr`] returns `None`.
+#[inline(always)]
+pub fn hqr_flat(h: &mut [f64], n: usize, out: &mut [Complex<f64>]) -> bool {
+    assert!(h.len() == n * n && out.len() == n);
     // 1-based indexing as in the reference, to keep the translation literal.
     macro_rules! a {
         ($i:expr, $j:expr) => {
-            h[($i) - 1][($j) - 1]
+            h[(($i) - 1) * n + ($j) - 1]
         };
     }
     let eps = f64::EPSILON;
-    let mut out = [Complex::new(0.0, 0.0); N];
-    let n = N;
+    out.fill(Complex::new(0.0, 0.0));
     let mut anorm = 0.0;
     for i in 1..=n {
         for j in i.saturating_sub(1).max(1)..=n {
@@ -180,7 +212,7 @@ pub fn hqr<const N: usize>(h: &mut [[f64; N]; N]) -> Option<[Complex<f64>; N]> {
         }
     }
     if !anorm.is_finite() {
-        return None;
+        return false;
     }
     let mut nn = n;
     let mut t = 0.0;
@@ -231,7 +263,7 @@ pub fn hqr<const N: usize>(h: &mut [[f64; N]; N]) -> Option<[Complex<f64>; N]> {
             }
             // No roots yet: a QR step on rows/columns l..=nn.
             if its == MAX_QR_ITERATIONS {
-                return None;
+                return false;
             }
             if its > 0 && its % 10 == 0 {
                 // Exceptional shift.
@@ -328,7 +360,7 @@ pub fn hqr<const N: usize>(h: &mut [[f64; N]; N]) -> Option<[Complex<f64>; N]> {
             }
         }
     }
-    Some(out)
+    true
 }
 
 /// All eigenvalues of `a` ([`balance`], [`hessenberg`], [`hqr`]), and the
@@ -364,73 +396,106 @@ pub fn eigenvalues<const N: usize>(a: &[[f64; N]; N]) -> Option<[Complex<f64>; N
 pub fn eigenvector<const N: usize>(a: &[[f64; N]; N], lambda: Complex<f64>) -> [Complex<f64>; N] {
     let zero = Complex::new(0.0, 0.0);
     let mut lu = [[zero; N]; N];
+    let mut perm = [0usize; N];
+    let mut x = [zero; N];
+    eigenvector_flat(
+        a.as_flattened(),
+        N,
+        lambda,
+        lu.as_flattened_mut(),
+        &mut perm,
+        &mut x,
+    );
+    x
+}
+
+/// [`eigenvector`] on a row-major `n × n` slice, with scratch `lu` (`n²`) and
+/// `perm` (`n`); the eigenvector goes to `x` (length `n`).
+#[inline(always)]
+pub fn eigenvector_flat(
+    a: &[f64],
+    n: usize,
+    lambda: Complex<f64>,
+    lu: &mut [Complex<f64>],
+    perm: &mut [usize],
+    x: &mut [Complex<f64>],
+) {
+    assert!(a.len() == n * n && lu.len() == n * n && perm.len() == n && x.len() == n);
+    let zero = Complex::new(0.0, 0.0);
     let mut norm: f64 = 0.0;
-    for i in 0..N {
+    for i in 0..n {
         let mut row = 0.0;
-        for j in 0..N {
-            lu[i][j] = Complex::new(a[i][j], 0.0);
-            row += a[i][j].abs();
+        for j in 0..n {
+            lu[i * n + j] = Complex::new(a[i * n + j], 0.0);
+            row += a[i * n + j].abs();
         }
-        lu[i][i] -= lambda;
+        lu[i * n + i] -= lambda;
         norm = norm.max(row);
     }
+    // (For a zero matrix, √MIN_POSITIVE: its square, compared with |pivot|²
+    // below, must not underflow to 0.)
     let tiny = if norm > 0.0 {
         f64::EPSILON * norm
     } else {
-        f64::MIN_POSITIVE
+        f64::MIN_POSITIVE.sqrt()
     };
-    let mut perm = [0usize; N];
-    for k in 0..N {
+    for k in 0..n {
+        // Pivot by |·|² (the same order as |·|, without a hypot per entry).
         let mut piv = k;
-        let mut best = lu[k][k].norm();
-        for i in k + 1..N {
-            let v = lu[i][k].norm();
+        let mut best = lu[k * n + k].norm_sqr();
+        for i in k + 1..n {
+            let v = lu[i * n + k].norm_sqr();
             if v > best {
                 best = v;
                 piv = i;
             }
         }
         perm[k] = piv;
-        lu.swap(k, piv);
-        if lu[k][k].norm() < tiny {
-            lu[k][k] = Complex::new(tiny, 0.0);
+        if piv != k {
+            for j in 0..n {
+                lu.swap(k * n + j, piv * n + j);
+            }
         }
-        let pivot = lu[k][k];
-        for i in k + 1..N {
-            let f = lu[i][k] / pivot;
-            lu[i][k] = f;
+        if lu[k * n + k].norm_sqr() < tiny * tiny {
+            lu[k * n + k] = Complex::new(tiny, 0.0);
+        }
+        let pivot = lu[k * n + k];
+        // Row slices instead of indices: same operations, no bounds checks.
+        let (top, below) = lu.split_at_mut((k + 1) * n);
+        let row_k = &top[k * n + k + 1..(k + 1) * n];
+        for row_i in below.chunks_exact_mut(n) {
+            let f = row_i[k] / pivot;
+            row_i[k] = f;
             if f != zero {
-                for j in k + 1..N {
-                    let u = lu[k][j];
-                    lu[i][j] -= f * u;
+                for (a, &u) in row_i[k + 1..].iter_mut().zip(row_k) {
+                    *a -= f * u;
                 }
             }
         }
     }
     // Start from a vector with no special structure.
-    let mut x = [zero; N];
     for (i, xi) in x.iter_mut().enumerate() {
-        *xi = Complex::new(1.0, 0.5 * (i as f64 + 1.0) / N as f64);
+        *xi = Complex::new(1.0, 0.5 * (i as f64 + 1.0) / n as f64);
     }
     for _ in 0..3 {
-        for k in 0..N {
+        for k in 0..n {
             x.swap(k, perm[k]);
         }
-        for i in 0..N {
+        for (i, row) in lu.chunks_exact(n).enumerate() {
             let mut s = x[i];
-            for j in 0..i {
-                s -= lu[i][j] * x[j];
+            for (l, xj) in row[..i].iter().zip(&x[..i]) {
+                s -= l * xj;
             }
             x[i] = s;
         }
-        for i in (0..N).rev() {
+        for (i, row) in lu.chunks_exact(n).enumerate().rev() {
             let mut s = x[i];
-            for j in i + 1..N {
-                s -= lu[i][j] * x[j];
+            for (u, xj) in row[i + 1..].iter().zip(&x[i + 1..]) {
+                s -= u * xj;
             }
-            x[i] = s / lu[i][i];
+            x[i] = s / row[i];
         }
-        let m = x.iter().map(|c| c.norm()).fold(0.0, f64::max);
+        let m = x.iter().map(|c| c.norm_sqr()).fold(0.0, f64::max).sqrt();
         if !(m > 0.0 && m.is_finite()) {
             break;
         }
@@ -438,15 +503,15 @@ pub fn eigenvector<const N: usize>(a: &[[f64; N]; N], lambda: Complex<f64>) -> [
             *xi /= m;
         }
     }
-    normalise(&mut x);
-    x
+    normalise(x);
 }
 
-/// Scale `x` to unit 2-norm with its largest component real and positive.
-pub(crate) fn normalise<const N: usize>(x: &mut [Complex<f64>; N]) {
+/// Scale `x` to unit 2-norm with its largest component real and positive
+/// (the first largest, on ties).
+pub fn normalise(x: &mut [Complex<f64>]) {
     let mut big = 0;
-    for i in 0..N {
-        if x[i].norm() > x[big].norm() {
+    for i in 0..x.len() {
+        if x[i].norm_sqr() > x[big].norm_sqr() {
             big = i;
         }
     }
@@ -457,6 +522,68 @@ pub(crate) fn normalise<const N: usize>(x: &mut [Complex<f64>; N]) {
     let phase = x[big] / x[big].norm();
     for xi in x.iter_mut() {
         *xi /= phase * n2;
+    }
+}
+
+/// Heap workspace for the runtime-sized path: the same balancing, Hessenberg
+/// reduction, Francis QR and inverse iteration as the fixed-size functions,
+/// on an `n × n` matrix given at run time.
+#[derive(Debug, Clone)]
+pub struct Workspace {
+    n: usize,
+    /// The balanced matrix `D⁻¹ A D` (row-major).
+    balanced: Vec<f64>,
+    /// The balancing scales `D`.
+    d: Vec<f64>,
+    h: Vec<f64>,
+    v: Vec<f64>,
+    lu: Vec<Complex<f64>>,
+    perm: Vec<usize>,
+}
+
+impl Workspace {
+    /// The eigenvalues of the row-major `n × n` matrix `a` (the order of
+    /// [`hqr`]); keeps the balanced matrix for [`Workspace::eigenvector`].
+    /// `None` if `a` is not finite or QR does not converge.
+    pub fn eigenvalues(a: &[f64], n: usize) -> Option<(Self, Vec<Complex<f64>>)> {
+        assert_eq!(a.len(), n * n, "eigenvalues: matrix is not {n} × {n}");
+        if a.iter().any(|x| !x.is_finite()) {
+            return None;
+        }
+        let mut ws = Workspace {
+            n,
+            balanced: a.to_vec(),
+            d: vec![1.0; n],
+            h: vec![0.0; n * n],
+            v: vec![0.0; n],
+            lu: vec![Complex::new(0.0, 0.0); n * n],
+            perm: vec![0; n],
+        };
+        balance_flat(&mut ws.balanced, n, &mut ws.d);
+        ws.h.copy_from_slice(&ws.balanced);
+        hessenberg_flat(&mut ws.h, n, &mut ws.v);
+        let mut ev = vec![Complex::new(0.0, 0.0); n];
+        hqr_flat(&mut ws.h, n, &mut ev).then_some((ws, ev))
+    }
+
+    /// Eigenvector of the original matrix for `lambda`: inverse iteration on
+    /// the balanced matrix ([`eigenvector`]), mapped back `x = D x̃`, unit
+    /// 2-norm, largest component real positive.
+    pub fn eigenvector(&mut self, lambda: Complex<f64>) -> Vec<Complex<f64>> {
+        let mut x = vec![Complex::new(0.0, 0.0); self.n];
+        eigenvector_flat(
+            &self.balanced,
+            self.n,
+            lambda,
+            &mut self.lu,
+            &mut self.perm,
+            &mut x,
+        );
+        for (xi, di) in x.iter_mut().zip(&self.d) {
+            *xi *= *di;
+        }
+        normalise(&mut x);
+        x
     }
 }
 

@@ -2,7 +2,7 @@
 //!
 //! At the steady-sliding equilibrium `z*` of a model (all velocities zero,
 //! sliding velocity `v = V`), the slip equations linearise to `ż = A z` with
-//! `A = ∂f/∂z(z*)` the model's analytic Jacobian ([`Model::jacobian`]). Its
+//! `A = ∂f/∂z(z*)` the model's analytic Jacobian ([`System::state_jacobian`]). Its
 //! eigenvalues `λ = σ ± iω` give each mode's growth rate σ (1/s), frequency
 //! `ω/2π` and damping ratio `−σ/|λ|`; by Lyapunov's indirect method the
 //! equilibrium is asymptotically stable if every σ < 0 and unstable if some
@@ -24,6 +24,12 @@
 //! - [`analyse`]: all eigenvalues, eigenvectors and mode descriptions;
 //! - [`max_growth_rate`]: the fast path for stability maps (eigenvalues only,
 //!   no heap allocation, ≈ 2 µs for the 8-state disc–pad model);
+//! - [`modal::analyse_matrix`]: the same analysis for a state matrix of any
+//!   size known at run time (faer for thousands of states), and complex mode
+//!   shapes ([`modal::mode_shape`]);
+//! - [`sweep::sweep`]: every eigenvalue along a one-parameter sweep, tracked
+//!   continuously (MAC + Hungarian assignment), with located onsets and
+//!   coalescences (the mode-coupling diagram);
 //! - [`critical`]: a grid scan plus Brent's method for the parameter value
 //!   at which the stability changes;
 //! - [`track`]: eigenvalues followed along a parameter path.
@@ -32,9 +38,12 @@
 //! the reasons it is hand-written).
 
 pub mod eigen;
+pub mod lumped;
+pub mod modal;
+pub mod sweep;
 pub mod track;
 
-use crate::model::{Model, ModelError};
+use crate::model::{ModelError, System};
 use crate::params::ParamError;
 use nalgebra::Complex;
 use serde::Serialize;
@@ -132,8 +141,9 @@ pub struct Eigen {
     /// Index of the position coordinate with the largest share of the
     /// mode's energy (see [`Eigen::participation`]).
     pub dominant: usize,
-    /// Name of that coordinate (`Model::state_names`).
-    pub dominant_name: &'static str,
+    /// Name of that coordinate (`System::names`, or the names given to
+    /// [`modal::analyse_matrix`]).
+    pub dominant_name: String,
     /// Energy share of each position coordinate `i < N/2` (sums to 1):
     /// `E_i ∝ m_i·(|u_{n+i}|² + |λ|²·|u_i|²)` with `u` the eigenvector and
     /// `n = N/2`, i.e. twice the kinetic energy of coordinate `i` counted
@@ -213,16 +223,16 @@ impl Inertia for crate::model::hoffmann::Hoffmann {
 /// The steady-sliding state `z*` and the state matrix `A = ∂f/∂z(z*)`,
 /// both checked finite.
 #[allow(clippy::type_complexity)]
-pub fn state_matrix<M: Model<N> + ?Sized, const N: usize>(
+pub fn state_matrix<M: System<N> + ?Sized, const N: usize>(
     model: &M,
 ) -> Result<([f64; N], [[f64; N]; N]), StabilityError> {
-    let z = model.equilibrium()?;
+    let z = model.steady_sliding()?;
     if z.iter().any(|x| !x.is_finite()) {
         return Err(StabilityError::NonFinite {
             what: "equilibrium",
         });
     }
-    let a = model.jacobian(&z);
+    let a = model.state_jacobian(&z);
     if a.iter().flatten().any(|x| !x.is_finite()) {
         return Err(StabilityError::NonFinite { what: "Jacobian" });
     }
@@ -231,7 +241,7 @@ pub fn state_matrix<M: Model<N> + ?Sized, const N: usize>(
 
 /// A state matrix with finite entries can still have eigenvalues that
 /// overflow (entries near 1e300): an error, like a non-finite matrix.
-fn check_finite(ev: &[Complex<f64>]) -> Result<(), StabilityError> {
+pub(crate) fn check_finite(ev: &[Complex<f64>]) -> Result<(), StabilityError> {
     if ev.iter().all(|e| e.re.is_finite() && e.im.is_finite()) {
         Ok(())
     } else {
@@ -248,7 +258,7 @@ fn check_finite(ev: &[Complex<f64>]) -> Result<(), StabilityError> {
 /// [`ModelError::NoSteadySliding`] passes through with its message), the
 /// analytic Jacobian there, Parlett–Reinsch balancing, Francis QR for all N
 /// eigenvalues, inverse iteration for each eigenvector ([`eigen`]).
-pub fn analyse<M: Model<N> + ?Sized, const N: usize>(
+pub fn analyse<M: System<N> + ?Sized, const N: usize>(
     model: &M,
 ) -> Result<Analysis, StabilityError> {
     analyse_impl(model, None)
@@ -256,7 +266,7 @@ pub fn analyse<M: Model<N> + ?Sized, const N: usize>(
 
 /// [`analyse`] with the energy share of each coordinate weighted by its mass
 /// (`masses.len() == N/2`, all > 0; see [`Inertia`]).
-pub fn analyse_with_masses<M: Model<N> + ?Sized, const N: usize>(
+pub fn analyse_with_masses<M: System<N> + ?Sized, const N: usize>(
     model: &M,
     masses: &[f64],
 ) -> Result<Analysis, StabilityError> {
@@ -269,72 +279,46 @@ pub fn analyse_with_masses<M: Model<N> + ?Sized, const N: usize>(
     analyse_impl(model, Some(masses))
 }
 
-fn analyse_impl<M: Model<N> + ?Sized, const N: usize>(
+fn analyse_impl<M: System<N> + ?Sized, const N: usize>(
     model: &M,
     masses: Option<&[f64]>,
 ) -> Result<Analysis, StabilityError> {
     let (z, a) = state_matrix(model)?;
     let (ev, bal, d) = eigen::eigenvalues_balanced(&a).ok_or(StabilityError::NoConvergence)?;
     check_finite(&ev)?;
-    let names = model.state_names();
-    let n = N / 2;
-    let mut modes: Vec<Eigen> = ev
+    let names = model.names();
+    // A real matrix's eigenvector of λ̄ is the conjugate of λ's: computed once per pair.
+    let mut done: Vec<(Complex<f64>, Vec<Complex<f64>>)> = Vec::with_capacity(N);
+    let modes: Vec<Eigen> = ev
         .iter()
         .map(|&lambda| {
-            // Inverse iteration on the balanced matrix, mapped back: u = D ũ.
-            let mut u = eigen::eigenvector(&bal, lambda);
-            for (ui, di) in u.iter_mut().zip(d.iter()) {
-                *ui *= *di;
-            }
-            eigen::normalise(&mut u);
-            let mag = lambda.norm();
-            let mut e: Vec<f64> = (0..n)
-                .map(|i| {
-                    let m = masses.map_or(1.0, |m| m[i]);
-                    m * (u[n + i].norm_sqr() + mag * mag * u[i].norm_sqr())
-                })
-                .collect();
-            let mut total: f64 = e.iter().sum();
-            if total <= 0.0 || !total.is_finite() {
-                e = (0..n).map(|i| u[i].norm_sqr()).collect();
-                total = e.iter().sum();
-            }
-            if total > 0.0 {
-                e.iter_mut().for_each(|x| *x /= total);
-            }
-            let dominant = (0..n).max_by(|&i, &j| e[i].total_cmp(&e[j])).unwrap_or(0);
-            Eigen {
-                re: lambda.re,
-                im: lambda.im,
-                freq_hz: lambda.im.abs() / (2.0 * std::f64::consts::PI),
-                damping_ratio: if mag > 0.0 { -lambda.re / mag } else { 0.0 },
-                growing: is_growing(lambda.re, lambda.im),
-                neutral: is_neutral(lambda.re, lambda.im),
-                dominant,
-                dominant_name: names.get(dominant).copied().unwrap_or(""),
-                participation: e,
-                vector: u.to_vec(),
-            }
+            let pair = done
+                .iter()
+                .find(|(l, _)| l.im != 0.0 && *l == lambda.conj());
+            let u = if let Some((_, v)) = pair {
+                v.iter().map(|x| x.conj()).collect()
+            } else {
+                // Inverse iteration on the balanced matrix, mapped back: u = D ũ.
+                let mut u = eigen::eigenvector(&bal, lambda);
+                for (ui, di) in u.iter_mut().zip(d.iter()) {
+                    *ui *= *di;
+                }
+                eigen::normalise(&mut u);
+                let u = u.to_vec();
+                done.push((lambda, u.clone()));
+                u
+            };
+            modal::describe(lambda, u, masses, &names)
         })
         .collect();
-    modes.sort_by(|p, q| q.re.total_cmp(&p.re).then(q.im.total_cmp(&p.im)));
-    let growing = modes.iter().any(|m| m.growing);
-    let neutral = !growing && modes.iter().any(|m| m.neutral);
-    Ok(Analysis {
-        max_growth_rate: modes.first().map_or(f64::NEG_INFINITY, |m| m.re),
-        stable: !growing && !neutral,
-        neutral,
-        least_stable: 0,
-        equilibrium: z.to_vec(),
-        eigen: modes,
-    })
+    Ok(modal::finish(modes, z.to_vec()))
 }
 
 /// Fast path for stability maps: the largest growth rate σ_max (1/s) of the
 /// steady-sliding state and the frequency `|Im λ|/2π` (Hz) of that mode
 /// (0 for a real eigenvalue). Eigenvalues only, on stack arrays: no heap
 /// allocation. Same equilibrium, Jacobian and eigen-solver as [`analyse`].
-pub fn max_growth_rate<M: Model<N> + ?Sized, const N: usize>(
+pub fn max_growth_rate<M: System<N> + ?Sized, const N: usize>(
     model: &M,
 ) -> Result<(f64, f64), StabilityError> {
     let (_, a) = state_matrix(model)?;

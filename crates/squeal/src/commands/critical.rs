@@ -54,7 +54,7 @@ pub fn parse_interval(spec: &str, flag: &str) -> Result<(String, f64, f64), Inpu
 /// the one that is not cannot, naming it (LO or HI).
 pub fn check_endpoints(model: &AnyModel, name: &str, lo: f64, hi: f64) -> Result<(), String> {
     for (end, v) in [("LO", lo), ("HI", hi)] {
-        let mut m = *model;
+        let mut m = model.clone();
         if let Err(e) = m.set(name, v) {
             return Err(format!("{end} = {v}: {e}"));
         }
@@ -64,10 +64,10 @@ pub fn check_endpoints(model: &AnyModel, name: &str, lo: f64, hi: f64) -> Result
 
 /// Least stable growth rate and its frequency with `name` set to `value`.
 pub fn growth_at(model: &AnyModel, name: &str, value: f64) -> Result<(f64, f64), StabilityError> {
-    let mut m = *model;
+    let mut m = model.clone();
     m.set(name, value)?;
     m.validate()?;
-    crate::with_model!(&m, mm => stability::max_growth_rate(mm))
+    m.max_growth_rate()
 }
 
 /// Locate the crossing of `name` in `[lo, hi]`.

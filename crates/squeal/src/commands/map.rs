@@ -13,7 +13,8 @@ use rayon::prelude::*;
 use serde_json::json;
 use squeal_core::integrate::{Flow, Sink};
 use squeal_core::stability::StabilityError;
-use squeal_core::{simulate, EventKind, Mode, Model};
+use squeal_core::System;
+use squeal_core::{simulate, EventKind, Mode};
 use squeal_plot::{Colormap, Format, HeatmapSpec};
 use std::io::Write;
 use std::path::PathBuf;
@@ -117,11 +118,10 @@ pub fn parse_axis(spec: &str, flag: &str, log: bool, model: &AnyModel) -> Result
 /// Unit of a parameter, for axis labels.
 pub fn unit_of(model: &AnyModel, name: &str) -> &'static str {
     model
-        .param_specs()
-        .iter()
-        .chain(model.friction().params())
-        .find(|s| s.name == name)
-        .map(|s| s.unit)
+        .keys()
+        .into_iter()
+        .find(|k| k.0 == name)
+        .map(|k| k.1)
         .unwrap_or("")
 }
 
@@ -140,7 +140,7 @@ pub fn linear_grid(
         .into_par_iter()
         .map(|k| {
             let (i, j) = (k % nx, k / nx);
-            let mut m = *model;
+            let mut m = model.clone();
             let r = m
                 .set(&y.name, y.values[j])
                 .map_err(StabilityError::from)
@@ -246,11 +246,11 @@ impl<const N: usize> Sink<N> for Watch {
     }
 }
 
-fn transient_point<M: Model<N>, const N: usize>(
+fn transient_point<M: System<N>, const N: usize>(
     model: &M,
     sc: &Scenario,
 ) -> Result<Outcome, String> {
-    let names = model.state_names();
+    let names = model.names();
     let idx: Vec<usize> = (N / 2..N)
         .filter(|&i| names[i].starts_with("vx") || names[i] == "v")
         .collect();
@@ -331,7 +331,10 @@ pub fn transient_grid(
                 .map_err(|e| e.to_string())
                 // Each point gets its own step budget (its stiffness differs).
                 .and_then(|_| crate::feasible::prepare(&mut s).map_err(|e| e.to_string()))
-                .and_then(|_| crate::with_model!(&s.model, m => transient_point(m, &s)));
+                .and_then(|_| {
+                    crate::with_system!(&s.model, m => transient_point(m, &s),
+                    else => Err(s.model.check_simulable().err().unwrap_or_default()))
+                });
             progress.inc(1);
             r.unwrap_or(Outcome {
                 class: "failed",

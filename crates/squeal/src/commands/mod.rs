@@ -1,6 +1,8 @@
 //! One module per command.
 
+pub mod branch;
 pub mod critical;
+pub mod cycle;
 pub mod listen;
 pub mod map;
 pub mod plot;
@@ -8,3 +10,4 @@ pub mod reproduce;
 pub mod scenario;
 pub mod simulate;
 pub mod stability;
+pub mod sweep;

@@ -54,7 +54,7 @@ struct Linear {
     growing: bool,
     neutral: bool,
     /// (σ, ω, dominant) of every eigenvalue with ω ≥ 0, sorted by σ.
-    modes: Vec<(f64, f64, &'static str)>,
+    modes: Vec<(f64, f64, String)>,
 }
 
 /// Everything measured on one set.
@@ -170,7 +170,7 @@ fn linear_of(model: &AnyModel) -> Result<Linear, String> {
             .eigen
             .iter()
             .filter(|e| e.im >= 0.0)
-            .map(|e| (e.re, e.im, e.dominant_name))
+            .map(|e| (e.re, e.im, e.dominant_name.clone()))
             .collect(),
     })
 }
@@ -423,7 +423,7 @@ fn sweeps(set15: &Scenario) -> Result<Sweeps, RunError> {
     for &n in &[100.0, 500.0, 2000.0, 5000.0] {
         for i in 1..=200 {
             let v = uc * (1.0 + 2.0 * i as f64 / 200.0);
-            let mut m = *base;
+            let mut m = base.clone();
             let ok = m
                 .set("V", v)
                 .and(m.set("N", n))
@@ -432,7 +432,7 @@ fn sweeps(set15: &Scenario) -> Result<Sweeps, RunError> {
             if ok.is_err() {
                 continue;
             }
-            if let Ok((s, _)) = crate::with_model!(&m, mm => stability::max_growth_rate(mm)) {
+            if let Ok((s, _)) = m.max_growth_rate() {
                 worst.0 += 1;
                 if s > worst.1 {
                     worst = (worst.0, s, v, n);
@@ -440,13 +440,11 @@ fn sweeps(set15: &Scenario) -> Result<Sweeps, RunError> {
             }
         }
     }
-    let mut m = *base;
+    let mut m = base.clone();
     let _ = m.set("V", 0.9 * uc);
-    let below = crate::with_model!(&m, mm => stability::max_growth_rate(mm))
-        .map(|r| r.0)
-        .unwrap_or(f64::NAN);
+    let below = m.max_growth_rate().map(|r| r.0).unwrap_or(f64::NAN);
     let at_n = |n: f64| {
-        let mut m = *base;
+        let mut m = base.clone();
         m.set("N", n).ok()?;
         m.set("V", 1.0).ok()?;
         Some(m)
@@ -454,10 +452,10 @@ fn sweeps(set15: &Scenario) -> Result<Sweeps, RunError> {
     let crit = |n: f64| {
         let m = at_n(n)?;
         let f = |c: f64| {
-            let mut mm = m;
+            let mut mm = m.clone();
             mm.set("c_dx", c)?;
             mm.set("c_px", c)?;
-            crate::with_model!(&mm, x => stability::max_growth_rate(x))
+            mm.max_growth_rate()
         };
         stability::critical(f, 0.0, 100.0, &stability::CriticalOptions::default())
             .ok()
@@ -1631,7 +1629,7 @@ fn report_html(md: &str) -> String {
 fn on_map<'a>(rs: &'a [SetResult], base: &AnyModel) -> Vec<&'a SetResult> {
     rs.iter()
         .filter(|r| {
-            let mut m = r.sc.model;
+            let mut m = r.sc.model.clone();
             r.p("V") > 0.0
                 && m.set("V", base.get("V").unwrap_or(f64::NAN)).is_ok()
                 && m.set("N", base.get("N").unwrap_or(f64::NAN)).is_ok()
@@ -1663,13 +1661,11 @@ fn draw_map(rs: &[SetResult], dir: &Path) -> Result<String, RunError> {
         .into_par_iter()
         .map(|k| {
             let (i, j) = (k % xs.len(), k / xs.len());
-            let mut m = base;
+            let mut m = base.clone();
             if m.set("V", xs[i]).and(m.set("N", ys[j])).is_err() {
                 return f64::NAN;
             }
-            crate::with_model!(&m, mm => stability::max_growth_rate(mm))
-                .map(|r| r.0)
-                .unwrap_or(f64::NAN)
+            m.max_growth_rate().map(|r| r.0).unwrap_or(f64::NAN)
         })
         .collect();
     // Group the sets by position so that coincident sets share one label.

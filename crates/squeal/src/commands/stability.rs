@@ -1,6 +1,8 @@
-//! `squeal stability [SCENARIO] [--set …] [--json]`: every eigenvalue of the
-//! steady-sliding state, each mode's growth rate, frequency, damping ratio and
-//! dominant coordinate, and the verdict (MODEL.md §5).
+//! `squeal stability [SCENARIO] [--set …] [--json] [--out DIR]`: every
+//! eigenvalue of the steady-sliding state, each mode's growth rate,
+//! frequency, damping ratio, dominant coordinate and complex mode shape
+//! (amplitude and phase per dof; in `--json` and in `DIR/modes.csv`), and the
+//! verdict (MODEL.md §5).
 
 use crate::commands::simulate::resolve;
 use crate::model::AnyModel;
@@ -19,6 +21,54 @@ pub struct StabilityArgs {
     /// Print a JSON document on stdout instead of the table.
     #[arg(long)]
     json: bool,
+    /// Write modes.csv (complex mode shapes of every mode) into this folder.
+    #[arg(long)]
+    out: Option<std::path::PathBuf>,
+}
+
+/// How mode shapes are normalised (stated in the JSON and the README).
+pub const SHAPE_NORMALISATION: &str = "position part of the eigenvector divided by its largest component: that dof has amplitude 1 and phase 0, every amplitude is in [0, 1], phases in degrees in (-180, 180]";
+
+/// Amplitude and phase (degrees) of every position dof of a mode.
+fn shape_of(e: &squeal_core::stability::Eigen) -> Vec<(f64, f64)> {
+    use squeal_core::stability::modal::{amplitude_phase, mode_shape};
+    amplitude_phase(&mode_shape(e))
+}
+
+/// Write `modes.csv`: one row per mode and position dof,
+/// `mode,growth_rate,freq_hz,damping_ratio,dof,amplitude,phase_deg`, modes
+/// numbered as in the table (by growth rate).
+pub fn write_modes_csv(
+    path: &std::path::Path,
+    model: &AnyModel,
+    an: &Analysis,
+) -> Result<(), RunError> {
+    use std::io::Write;
+    let io = |e: std::io::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
+    writeln!(
+        w,
+        "mode,growth_rate,freq_hz,damping_ratio,dof,amplitude,phase_deg"
+    )
+    .map_err(io)?;
+    let names = model.state_names();
+    for (k, e) in an.eigen.iter().enumerate() {
+        for (i, (amp, ph)) in shape_of(e).into_iter().enumerate() {
+            writeln!(
+                w,
+                "{},{:e},{:e},{:e},{},{:e},{:e}",
+                k + 1,
+                e.re,
+                e.freq_hz,
+                e.damping_ratio,
+                names.get(i).map_or("", String::as_str),
+                amp,
+                ph
+            )
+            .map_err(io)?;
+        }
+    }
+    w.flush().map_err(io)
 }
 
 /// A stability failure as a command error: no steady sliding or bad
@@ -35,24 +85,29 @@ pub fn stability_error(e: StabilityError) -> RunError {
 
 /// Full analysis of any model, with mass-weighted mode attribution.
 pub fn analyse(model: &AnyModel) -> Result<Analysis, StabilityError> {
-    use squeal_core::stability::Inertia;
-    crate::with_model!(model, m => stability::analyse_with_masses(m, &m.position_masses()))
+    model.analyse()
 }
 
 /// The JSON document of an analysis.
 pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
+    let names = model.state_names();
     let eig: Vec<Value> = an
         .eigen
         .iter()
         .map(|e| {
+            let shape: Vec<Value> = shape_of(e)
+                .into_iter()
+                .enumerate()
+                .map(|(i, (a, p))| json!({ "dof": names.get(i).map_or("", String::as_str), "amplitude": a, "phase_deg": p }))
+                .collect();
             json!({
                 "re": e.re, "im": e.im, "freq_hz": e.freq_hz,
                 "damping_ratio": e.damping_ratio, "dominant": e.dominant_name, "growing": e.growing,
                 "neutral": e.neutral,
+                "shape": shape,
             })
         })
         .collect();
-    let names = model.state_names();
     let eq: serde_json::Map<String, Value> = names
         .iter()
         .zip(&an.equilibrium)
@@ -67,6 +122,7 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
         "verdict": verdict_word(an),
         "least_stable": { "re": ls.re, "im": ls.im, "freq_hz": ls.freq_hz, "dominant": ls.dominant_name },
         "equilibrium": eq,
+        "shape_normalisation": SHAPE_NORMALISATION,
     })
 }
 
@@ -86,7 +142,7 @@ pub fn verdict_word(an: &Analysis) -> &'static str {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Lever {
     /// Parameter name.
-    pub param: &'static str,
+    pub param: String,
     /// Its unit.
     pub unit: &'static str,
     /// Its current value.
@@ -103,16 +159,15 @@ pub struct Lever {
 /// (±1e5 for a signed parameter) by [`stability::critical`].
 pub fn levers(model: &AnyModel) -> Vec<Lever> {
     use squeal_core::params::ParamKind;
-    let specs = model.param_specs().iter().chain(model.friction().params());
     let mut out = Vec::new();
-    for spec in specs {
-        if spec.name == "t_ramp" {
+    for (name, unit, _, kind) in model.keys() {
+        if name == "t_ramp" || name.ends_with(".ramp") {
             continue; // a start-up setting, no part of steady sliding
         }
-        let Some(cur) = model.get(spec.name) else {
+        let Some(cur) = model.get(&name) else {
             continue;
         };
-        let (lo, hi) = match spec.kind {
+        let (lo, hi) = match kind {
             ParamKind::Positive => (cur / 1000.0, cur * 1000.0),
             ParamKind::NonNegative => (0.0, if cur > 0.0 { cur * 1000.0 } else { 1000.0 }),
             ParamKind::Any => (
@@ -125,8 +180,7 @@ pub fn levers(model: &AnyModel) -> Vec<Lever> {
                 continue;
             }
             // Search outwards from the current value: s ∈ [0, 1] maps to a + s (b − a).
-            let f =
-                |s: f64| crate::commands::critical::growth_at(model, spec.name, a + s * (b - a));
+            let f = |s: f64| crate::commands::critical::growth_at(model, &name, a + s * (b - a));
             let opts = CriticalOptions {
                 grid: 48,
                 ..CriticalOptions::default()
@@ -137,11 +191,11 @@ pub fn levers(model: &AnyModel) -> Vec<Lever> {
                 // parameter; refine it on the parameter itself, with the same
                 // Brent iteration and tolerance as `critical`, so a lever and
                 // `squeal critical` give the same boundary.
-                let (to, freq_hz) = refine(model, spec.name, rough, (b - a).abs(), (a, b))
+                let (to, freq_hz) = refine(model, &name, rough, (b - a).abs(), (a, b))
                     .unwrap_or((rough, c.freq_hz));
                 out.push(Lever {
-                    param: spec.name,
-                    unit: spec.unit,
+                    param: name.clone(),
+                    unit,
                     from: cur,
                     to,
                     freq_hz,
@@ -182,8 +236,19 @@ fn refine(
 /// Run the command.
 pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
+    if let Some(dest) = &a.out {
+        crate::staging::check_dest_as("--out", dest)?;
+    }
     let an = analyse(&sc.model).map_err(|e| crate::feasible::stability_failure(&sc.model, e))?;
-    let levers = levers(&sc.model);
+    if let Some(dest) = &a.out {
+        let stage = crate::run::Staging::new_as("--out", dest)?;
+        write_modes_csv(&stage.path("modes.csv"), &sc.model, &an)?;
+        stage.commit()?;
+    }
+    // Levers need hundreds of analyses: only for models of the fixed-size path.
+    let large = matches!(&sc.model, AnyModel::Lumped(l)
+        if l.dof_count() > squeal_core::model::lumped::MAX_SIM_DOFS);
+    let levers = if large { Vec::new() } else { levers(&sc.model) };
     if a.json {
         let mut doc = analysis_json(&sc.model, &an);
         doc["scenario"] = sc.to_json();
@@ -243,7 +308,12 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         ls.dominant_name,
         ls.re
     );
-    if levers.is_empty() {
+    if large {
+        crate::outln!(
+            "(levers are searched only for models of up to {} dofs)",
+            squeal_core::model::lumped::MAX_SIM_DOFS
+        );
+    } else if levers.is_empty() {
         crate::outln!("no single parameter change within ×1000 either way changes the verdict");
     } else {
         crate::outln!(

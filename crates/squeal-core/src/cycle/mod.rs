@@ -1,0 +1,941 @@
+//! Periodic orbits (limit cycles) of the non-smooth system: settling by
+//! simulation, Newton shooting on a Poincaré section, and Floquet multipliers
+//! from the monodromy matrix with a saltation matrix at every event.
+//!
+//! # The monodromy matrix
+//!
+//! Along a segment of the flow in a fixed mode the variational equation
+//! `Φ̇ = J(z(t)) Φ` (`J = ∂f/∂z` of that mode's field, in a sticking mode the
+//! reduced, constrained dynamics) is integrated on the integrator's own dense
+//! output with the fourth-order Magnus method
+//! `Ω = h/2 (J₁ + J₂) + √3 h²/12 [J₂, J₁]`, `Φ ← exp(Ω) Φ`, with `J` at the two
+//! Gauss points (exact when `J` is constant on the segment, as in every
+//! piecewise-linear model). At an event where guard `g` fires, taking the
+//! state `z⁻` (field `f⁻`) to `z⁺ = R(z⁻)` (field `f⁺`), the perturbation jumps
+//! by the saltation matrix (Leine & Nijmeijer 2004, Eq. 7.40; Aizerman &
+//! Gantmacher 1958)
+//!
+//! ```text
+//! S = P + (f⁺ − P f⁻) ∇gᵀ / (∇g · f⁻),     P = ∂R/∂z
+//! ```
+//!
+//! where `P` projects onto the sticking constraint when the event is a stick
+//! (that is where a sticking phase collapses a direction: a zero multiplier).
+//!
+//! # Shooting
+//!
+//! The unknowns are the state `z₀` on the section `z_k = c` and the period
+//! `T`; Newton's method solves `φ_T(z₀) − z₀ = 0`, `z₀,k − c = 0` with the
+//! bordered matrix `[[M − I, f(φ_T z₀)], [e_kᵀ, 0]]`.
+//!
+//! # Multipliers
+//!
+//! The non-trivial multipliers are the eigenvalues of the Poincaré map's
+//! Jacobian `(I − f e_kᵀ / f_k) M` (on the section, whose extra eigenvalue 0
+//! stands for the flow direction), so that slowly decaying modes (multipliers
+//! `exp(σT)` a hair below 1) are never confused with the trivial multiplier;
+//! the trivial one is reported separately as the Rayleigh quotient
+//! `fᵀ M f / fᵀ f` (1 up to the shooting residual).
+//!
+//! All matrices are formed in scaled coordinates (positions by the orbit's
+//! position amplitude, velocities by its velocity amplitude), so that the
+//! eigenvalues do not suffer from the state's units (MODEL.md §8).
+
+use crate::integrate::{IntegrateError, Solver, SolverOptions};
+use crate::model::{EventKind, Guards, Modes, System};
+use nalgebra::DMatrix;
+
+/// A Poincaré section: an upward crossing of `z[index] = level`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Section {
+    /// The state component (a velocity, by default).
+    pub index: usize,
+    /// The level it crosses upwards.
+    pub level: f64,
+}
+
+/// Settings of [`find_cycle`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CycleOptions {
+    /// Integrator settings (the same for settling, shooting and monodromy).
+    pub solver: SolverOptions,
+    /// The section; `None` chooses an upward zero of a velocity automatically.
+    pub section: Option<Section>,
+    /// Most integrator steps spent settling onto the cycle.
+    pub settle_steps: u64,
+    /// Most simulated time spent settling (s).
+    pub settle_time: f64,
+    /// Relative tolerance of the settling run (at least the solver's own):
+    /// settling only needs to come close, Newton's method does the rest.
+    pub settle_rtol: f64,
+    /// Two returns to the section count as the same point when they differ
+    /// by less than this, relative to the orbit's amplitude.
+    pub settle_tol: f64,
+    /// Most returns compared when looking for a period (period-m orbits).
+    pub max_returns: usize,
+    /// Shooting converges when the scaled residual is below this.
+    pub newton_tol: f64,
+    /// Most Newton iterations.
+    pub newton_iterations: usize,
+    /// Magnus steps per integrator step for the variational equations.
+    pub magnus_substeps: usize,
+}
+
+impl Default for CycleOptions {
+    fn default() -> Self {
+        CycleOptions {
+            solver: SolverOptions {
+                rtol: 1e-10,
+                ..SolverOptions::default()
+            },
+            section: None,
+            settle_steps: 20_000_000,
+            settle_time: 1000.0,
+            settle_rtol: 1e-8,
+            settle_tol: 1e-2,
+            max_returns: 8,
+            newton_tol: 1e-8,
+            newton_iterations: 30,
+            magnus_substeps: 2,
+        }
+    }
+}
+
+/// Why no cycle was found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CycleError {
+    /// The integrator failed.
+    #[error(transparent)]
+    Integrate(#[from] IntegrateError),
+    /// Settling did not reach a periodic orbit within the budget.
+    #[error("no periodic orbit found by t = {t:.6} s ({steps} steps): {cause}")]
+    NotSettled {
+        /// Simulated time reached.
+        t: f64,
+        /// Integrator steps taken.
+        steps: u64,
+        /// What was seen.
+        cause: String,
+    },
+    /// Newton's method did not converge.
+    #[error("shooting did not converge: {0}")]
+    Shooting(String),
+    /// Bad settings.
+    #[error("{0}")]
+    Bad(String),
+}
+
+/// One Floquet multiplier.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Multiplier {
+    /// Real part.
+    pub re: f64,
+    /// Imaginary part.
+    pub im: f64,
+    /// Whether this is the trivial multiplier (1, along the flow).
+    pub trivial: bool,
+}
+
+impl Multiplier {
+    /// Modulus.
+    pub fn abs(&self) -> f64 {
+        self.re.hypot(self.im)
+    }
+}
+
+/// A located periodic orbit.
+#[derive(Debug, Clone)]
+pub struct Cycle<const N: usize> {
+    /// Period (s).
+    pub period: f64,
+    /// The state on the section where the orbit starts.
+    pub z0: [f64; N],
+    /// The section.
+    pub section: Section,
+    /// The monodromy matrix `∂φ_T/∂z₀` (unscaled, row-major).
+    pub monodromy: [[f64; N]; N],
+    /// All `N` multipliers sorted by modulus, descending; one is trivial.
+    pub multipliers: Vec<Multiplier>,
+    /// Whether every non-trivial multiplier lies inside the unit circle.
+    pub stable: bool,
+    /// Largest modulus of the non-trivial multipliers.
+    pub max_multiplier: f64,
+    /// Scaled shooting residual `|φ_T(z₀) − z₀|` at the end.
+    pub residual: f64,
+    /// Newton iterations used.
+    pub iterations: usize,
+    /// Events on one period, counted by kind (index of [`EventKind::ALL`]).
+    pub events_per_period: [u64; 5],
+    /// Half peak-to-peak of every state over one period.
+    pub amplitude: [f64; N],
+    /// Simulated time spent settling (s).
+    pub settle_time: f64,
+}
+
+/// One period sampled densely: times, states and modes; events with their kind.
+#[derive(Debug, Clone, Default)]
+pub struct Orbit<const N: usize> {
+    /// Sample times from 0 to the period.
+    pub t: Vec<f64>,
+    /// States.
+    pub z: Vec<[f64; N]>,
+    /// Modes at each sample (for an event row: after it).
+    pub modes: Vec<Modes>,
+    /// The event at the sample, if the row is an event.
+    pub event: Vec<Option<(EventKind, usize)>>,
+}
+
+/// Largest `h·‖ΔJ‖` (scaled, ∞-norm) of one Magnus step.
+const MAGNUS_VARIATION: f64 = 1e-4;
+
+/// What integrating one period with the variational equations gives.
+struct Period<const N: usize> {
+    z_end: [f64; N],
+    /// Scaled monodromy `D⁻¹ M D`.
+    m: DMatrix<f64>,
+    events: [u64; 5],
+    lo: [f64; N],
+    hi: [f64; N],
+}
+
+/// Scale of each state: positions by the largest position amplitude,
+/// velocities by the largest velocity amplitude (floored at the tolerances).
+fn block_scales<const N: usize>(amp: &[f64; N], atol: &SolverOptions) -> [f64; N] {
+    let n = N / 2;
+    let pos = amp[..n].iter().fold(0.0f64, |m, a| m.max(*a));
+    let vel = amp[n..].iter().fold(0.0f64, |m, a| m.max(*a));
+    let pos = pos.max(atol.atol_pos.unwrap_or(crate::integrate::DEFAULT_ATOL_POS) * 1e3);
+    let vel = vel.max(atol.atol_vel.unwrap_or(crate::integrate::DEFAULT_ATOL_VEL) * 1e3);
+    let mut s = [0.0; N];
+    for (i, si) in s.iter_mut().enumerate() {
+        *si = if i < n { pos } else { vel };
+    }
+    s
+}
+
+/// Jacobian `∂f/∂z` of the field of `modes` at `(t, z)` by central
+/// differences, in scaled coordinates `D⁻¹ J D` (step `1e-6` of each scale).
+fn scaled_jacobian<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    t: f64,
+    modes: &Modes,
+    z: &[f64; N],
+    s: &[f64; N],
+    out: &mut DMatrix<f64>,
+) {
+    let mut fp = [0.0; N];
+    let mut fm = [0.0; N];
+    for j in 0..N {
+        let h = 1e-6 * s[j];
+        let mut zp = *z;
+        zp[j] += h;
+        let mut zm = *z;
+        zm[j] -= h;
+        sys.field(t, modes, &zp, &mut fp);
+        sys.field(t, modes, &zm, &mut fm);
+        let dz = zp[j] - zm[j];
+        for i in 0..N {
+            out[(i, j)] = (fp[i] - fm[i]) / dz * s[j] / s[i];
+        }
+    }
+}
+
+/// The guard of `modes` that `z` lies on (smallest scaled `|g|`).
+fn guard_on<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    t: f64,
+    modes: &Modes,
+    z: &[f64; N],
+    s: &[f64; N],
+) -> Option<crate::model::Guard<N>> {
+    let mut guards = Guards::default();
+    sys.mode_guards(modes, &mut guards);
+    let mut best: Option<(f64, crate::model::Guard<N>)> = None;
+    for g in guards.as_slice() {
+        let c = sys.guard_gradient(t, modes, g, z);
+        let norm: f64 = (0..N).map(|i| (c[i] * s[i]).abs()).sum();
+        if norm == 0.0 {
+            continue;
+        }
+        let v = (sys.guard_value(t, modes, g, z) / norm).abs();
+        if best.is_none_or(|(b, _)| v < b) {
+            best = Some((v, *g));
+        }
+    }
+    best.map(|(_, g)| g)
+}
+
+/// Saltation matrix (scaled) at an event from `modes_m` at `z_m` to
+/// `modes_p` at `z_p` (see the module documentation).
+fn saltation<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    t: f64,
+    modes_m: &Modes,
+    z_m: &[f64; N],
+    modes_p: &Modes,
+    z_p: &[f64; N],
+    s: &[f64; N],
+) -> DMatrix<f64> {
+    let Some(g) = guard_on(sys, t, modes_m, z_m, s) else {
+        return DMatrix::identity(N, N);
+    };
+    // P = ∂R/∂z by central differences of the reset map (exact for the
+    // affine projections of the models here).
+    let mut p = DMatrix::<f64>::identity(N, N);
+    for j in 0..N {
+        let h = 1e-6 * s[j];
+        let mut zp = *z_m;
+        zp[j] += h;
+        let mut zm = *z_m;
+        zm[j] -= h;
+        sys.switch(t, modes_m, &g, &mut zp);
+        sys.switch(t, modes_m, &g, &mut zm);
+        for i in 0..N {
+            p[(i, j)] = (zp[i] - zm[i]) / (2.0 * h) * s[j] / s[i];
+        }
+    }
+    let mut fm = [0.0; N];
+    let mut fp = [0.0; N];
+    sys.field(t, modes_m, z_m, &mut fm);
+    sys.field(t, modes_p, z_p, &mut fp);
+    let grad = sys.guard_gradient(t, modes_m, &g, z_m);
+    let fm_s = DMatrix::from_fn(N, 1, |i, _| fm[i] / s[i]);
+    let fp_s = DMatrix::from_fn(N, 1, |i, _| fp[i] / s[i]);
+    let g_s = DMatrix::from_fn(1, N, |_, j| grad[j] * s[j]);
+    let rate = (&g_s * &fm_s)[(0, 0)];
+    if rate == 0.0 || !rate.is_finite() {
+        return p;
+    }
+    let jump = &fp_s - &p * &fm_s;
+    &p + jump * g_s / rate
+}
+
+/// The time from which the model is autonomous (after its last breakpoint,
+/// e.g. the end of a load ramp): every period is integrated from there.
+fn autonomous_from<S: System<N> + ?Sized, const N: usize>(sys: &S) -> f64 {
+    let mut t = 0.0;
+    for _ in 0..1000 {
+        match sys.breakpoint_after(t) {
+            Some(b) if b > t => t = b,
+            _ => break,
+        }
+    }
+    t
+}
+
+/// Integrate one period `T` from `z0` with the variational equations.
+fn period_flow<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    z0: &[f64; N],
+    period: f64,
+    s: &[f64; N],
+    opts: &CycleOptions,
+    variational: bool,
+    mut orbit: Option<&mut Orbit<N>>,
+) -> Result<Period<N>, CycleError> {
+    let t_a = autonomous_from(sys);
+    let mut solver = Solver::new(sys, t_a, *z0, t_a + period, opts.solver)?;
+    let mut phi = DMatrix::<f64>::identity(N, N);
+    let mut j1 = DMatrix::<f64>::zeros(N, N);
+    let mut j2 = DMatrix::<f64>::zeros(N, N);
+    let mut events = [0u64; 5];
+    let mut lo = *z0;
+    let mut hi = *z0;
+    let g = 3f64.sqrt() / 6.0;
+    let subs = opts.magnus_substeps.max(1);
+    if let Some(o) = orbit.as_deref_mut() {
+        o.t.push(0.0);
+        o.z.push(*z0);
+        o.modes.push(solver.modes());
+        o.event.push(None);
+    }
+    while let Some(seg) = solver.step()? {
+        // Magnus steps short enough that the variation of J over one,
+        // h·‖J(t₁) − J(t₀)‖ (scaled), stays below MAGNUS_VARIATION: the
+        // method is exact for constant J, and its error grows with J's change.
+        let len = if variational { seg.t1 - seg.t0 } else { 0.0 };
+        let mut subs = subs;
+        if len > 0.0 {
+            scaled_jacobian(
+                sys,
+                seg.t0,
+                &seg.modes,
+                &solver.dense_at(seg.t0),
+                s,
+                &mut j1,
+            );
+            scaled_jacobian(
+                sys,
+                seg.t1,
+                &seg.modes,
+                &solver.dense_at(seg.t1),
+                s,
+                &mut j2,
+            );
+            let var = (0..N)
+                .map(|i| (0..N).map(|j| (j2[(i, j)] - j1[(i, j)]).abs()).sum::<f64>())
+                .fold(0.0, f64::max);
+            // J's change over a substep is var/subs, times its length len/subs.
+            let need = (len * var / MAGNUS_VARIATION).sqrt().ceil();
+            if need.is_finite() && need > subs as f64 {
+                subs = (need as usize).min(4096);
+            }
+        }
+        let h = len / subs as f64;
+        if h > 0.0 {
+            for k in 0..subs {
+                let a = seg.t0 + k as f64 * h;
+                let (ta, tb) = (a + (0.5 - g) * h, a + (0.5 + g) * h);
+                scaled_jacobian(sys, ta, &seg.modes, &solver.dense_at(ta), s, &mut j1);
+                scaled_jacobian(sys, tb, &seg.modes, &solver.dense_at(tb), s, &mut j2);
+                let omega = (&j1 + &j2) * (0.5 * h)
+                    + (&j2 * &j1 - &j1 * &j2) * (3f64.sqrt() / 12.0 * h * h);
+                phi = omega.exp() * phi;
+            }
+        }
+        // Extremes over the segment (dense output at a few points).
+        const PTS: usize = 8;
+        for k in 1..=PTS {
+            let t = seg.t0 + (seg.t1 - seg.t0) * k as f64 / PTS as f64;
+            let z = solver.dense_at(t);
+            for i in 0..N {
+                lo[i] = lo[i].min(z[i]);
+                hi[i] = hi[i].max(z[i]);
+            }
+            if let Some(o) = orbit.as_deref_mut() {
+                if k < PTS || !seg.switched {
+                    o.t.push(t - t_a);
+                    o.z.push(z);
+                    o.modes.push(seg.modes);
+                    o.event.push(None);
+                }
+            }
+        }
+        if seg.switched {
+            let z_m = solver.dense_at(seg.t1);
+            let z_p = *solver.state();
+            let modes_p = solver.modes();
+            if variational {
+                let sm = saltation(sys, seg.t1, &seg.modes, &z_m, &modes_p, &z_p, s);
+                phi = sm * phi;
+            }
+            if let Some(ev) = seg.event {
+                events[ev.index()] += 1;
+            }
+            if let Some(o) = orbit.as_deref_mut() {
+                o.t.push(seg.t1 - t_a);
+                o.z.push(z_m);
+                o.modes.push(seg.modes);
+                o.event.push(None);
+                o.t.push(seg.t1 - t_a);
+                o.z.push(z_p);
+                o.modes.push(modes_p);
+                o.event.push(seg.event.map(|e| (e, seg.contact)));
+            }
+            while let Some((ev, c, _, _)) = solver.take_pending_contact_event() {
+                events[ev.index()] += 1;
+                if let Some(o) = orbit.as_deref_mut() {
+                    if let Some(last) = o.event.last_mut() {
+                        if last.is_none() {
+                            *last = Some((ev, c));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    if phi.iter().any(|x| !x.is_finite()) {
+        return Err(CycleError::Shooting(
+            "the monodromy matrix is not finite".into(),
+        ));
+    }
+    Ok(Period {
+        z_end: *solver.state(),
+        m: phi,
+        events,
+        lo,
+        hi,
+    })
+}
+
+/// One return to the section while settling.
+#[derive(Clone, Copy)]
+struct Return<const N: usize> {
+    t: f64,
+    z: [f64; N],
+    lo: [f64; N],
+    hi: [f64; N],
+}
+
+/// Settle onto a cycle by simulation from `(t0, z0)`: returns the section,
+/// the state on it and a first guess of the period.
+pub fn settle<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    t0: f64,
+    z0: [f64; N],
+    opts: &CycleOptions,
+) -> Result<(Section, [f64; N], f64, f64), CycleError> {
+    let n = N / 2;
+    let t_end = t0 + opts.settle_time;
+    let mut sopts = opts.solver;
+    sopts.max_steps = opts.settle_steps;
+    sopts.rtol = sopts.rtol.max(opts.settle_rtol);
+    let mut solver = Solver::new(sys, t0, z0, t_end, sopts)?;
+    let candidates: Vec<Section> = match opts.section {
+        Some(s) => vec![s],
+        None => (n..N).map(|index| Section { index, level: 0.0 }).collect(),
+    };
+    let mut lo = vec![z0; candidates.len()];
+    let mut hi = vec![z0; candidates.len()];
+    let mut returns: Vec<Vec<Return<N>>> = vec![Vec::new(); candidates.len()];
+    let keep = 2 * opts.max_returns + 2;
+    let mut prev = z0;
+    loop {
+        let seg = match solver.step() {
+            Ok(Some(seg)) => seg,
+            Ok(None) => {
+                return Err(CycleError::NotSettled {
+                    t: solver.t(),
+                    steps: solver.stats().accepted,
+                    cause: not_settled_cause(&returns),
+                })
+            }
+            Err(IntegrateError::MaxSteps { t, steps }) => {
+                return Err(CycleError::NotSettled {
+                    t,
+                    steps,
+                    cause: not_settled_cause(&returns),
+                })
+            }
+            Err(e) => return Err(e.into()),
+        };
+        let z1 = solver.dense_at(seg.t1);
+        for (c, sec) in candidates.iter().enumerate() {
+            for i in 0..N {
+                lo[c][i] = lo[c][i].min(z1[i]);
+                hi[c][i] = hi[c][i].max(z1[i]);
+            }
+            let (g0, g1) = (prev[sec.index] - sec.level, z1[sec.index] - sec.level);
+            if !(g0 < 0.0 && g1 >= 0.0) {
+                continue;
+            }
+            // The crossing by linear interpolation (enough to compare returns
+            // to settle_tol); refined by bisection on the dense output once a
+            // period is found.
+            let th = g0 / (g0 - g1);
+            let tc = seg.t0 + th * (seg.t1 - seg.t0);
+            let z = solver.dense_at(tc);
+            let r = Return {
+                t: tc,
+                z,
+                lo: lo[c],
+                hi: hi[c],
+            };
+            lo[c] = z;
+            hi[c] = z;
+            let list = &mut returns[c];
+            list.push(r);
+            if list.len() > keep {
+                list.remove(0);
+            }
+            if let Some(found) = periodic(list, opts, n, sec.index) {
+                let (mut a, mut b) = (seg.t0, seg.t1);
+                for _ in 0..200 {
+                    let m = 0.5 * (a + b);
+                    if m <= a || m >= b {
+                        break;
+                    }
+                    if solver.dense_at(m)[sec.index] - sec.level < 0.0 {
+                        a = m;
+                    } else {
+                        b = m;
+                    }
+                }
+                let mut z_start = solver.dense_at(b);
+                z_start[sec.index] = sec.level;
+                return Ok((*sec, z_start, found, solver.t() - t0));
+            }
+        }
+        prev = if seg.switched { *solver.state() } else { z1 };
+    }
+}
+
+fn not_settled_cause<const N: usize>(returns: &[Vec<Return<N>>]) -> String {
+    if returns.iter().all(|r| r.len() < 2) {
+        "the motion does not oscillate (it may settle on steady sliding or stick)".into()
+    } else {
+        "the returns to the section never repeated (the oscillation may be dying out onto steady sliding, still growing, quasi-periodic or chaotic)".into()
+    }
+}
+
+/// If the last return repeats the one `m` returns earlier (m = 1, 2, …), the period.
+fn periodic<const N: usize>(
+    list: &[Return<N>],
+    opts: &CycleOptions,
+    n: usize,
+    index: usize,
+) -> Option<f64> {
+    let last = list.len() - 1;
+    for m in 1..=opts.max_returns {
+        // Need the amplitude over the m returns before it too.
+        if last < 2 * m {
+            break;
+        }
+        let mut amp = [0.0; N];
+        for r in &list[last + 1 - 2 * m..=last] {
+            for i in 0..N {
+                amp[i] = f64::max(amp[i], 0.5 * (r.hi[i] - r.lo[i]));
+            }
+        }
+        // The oscillation must neither decay nor grow between the two halves
+        // of the window, and stand clear of the integrator's tolerance.
+        let mut amp1 = [0.0f64; N];
+        let mut amp2 = [0.0f64; N];
+        for (k, r) in list[last + 1 - 2 * m..=last].iter().enumerate() {
+            let a = if k < m { &mut amp1 } else { &mut amp2 };
+            for i in 0..N {
+                a[i] = a[i].max(0.5 * (r.hi[i] - r.lo[i]));
+            }
+        }
+        let (v1, v2) = (
+            amp1[n..].iter().fold(0.0f64, |a, b| a.max(*b)),
+            amp2[n..].iter().fold(0.0f64, |a, b| a.max(*b)),
+        );
+        let floor = 1e4
+            * opts
+                .solver
+                .atol_vel
+                .unwrap_or(crate::integrate::DEFAULT_ATOL_VEL);
+        if v2 <= floor || (v2 - v1).abs() > opts.settle_tol * v2 {
+            continue;
+        }
+        let s = block_scales(&amp, &opts.solver);
+        // The section's velocity must carry the largest share of the motion
+        // (a small velocity crosses its level several times a period).
+        let vel_max = amp[n..].iter().fold(0.0f64, |a, b| a.max(*b));
+        if index >= n && amp[index] < 0.5 * vel_max {
+            return None;
+        }
+        let err = (0..N)
+            .map(|i| ((list[last].z[i] - list[last - m].z[i]) / s[i]).abs())
+            .fold(0.0, f64::max);
+        let err2 = (0..N)
+            .map(|i| ((list[last - m].z[i] - list[last - 2 * m].z[i]) / s[i]).abs())
+            .fold(0.0, f64::max);
+        if err <= opts.settle_tol && err2 <= 10.0 * opts.settle_tol {
+            return Some(list[last].t - list[last - m].t);
+        }
+    }
+    None
+}
+
+/// Find the periodic orbit reached from `(t0, z0)`: settle, shoot, and
+/// compute its Floquet multipliers.
+pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    t0: f64,
+    z0: [f64; N],
+    opts: &CycleOptions,
+) -> Result<Cycle<N>, CycleError> {
+    // What the motion settles on is stable: an unstable periodic orbit met
+    // on the way (the brake's normal vibration while the pad's mode still
+    // grows, say) is left by simulating on until its instability has grown
+    // a thousandfold, then settling again (at most four times).
+    let (mut t, mut z) = (t0, z0);
+    let mut spent = 0.0;
+    let mut attempt = 0;
+    let mut local = *opts;
+    loop {
+        // Shooting that fails from a settled state (a slowly changing
+        // motion that only looked periodic) settles longer, to a tighter match.
+        let (c, settled) = match settle_and_shoot(sys, t, z, &local) {
+            Err(CycleError::Shooting(_)) if attempt < 3 && local.settle_tol > 1e-6 => {
+                attempt += 1;
+                local.settle_tol *= 0.1;
+                continue;
+            }
+            other => other?,
+        };
+        spent += settled;
+        attempt += 1;
+        if c.stable || attempt >= 4 || c.max_multiplier <= 1.0 {
+            let mut c = c;
+            c.settle_time = spent;
+            return Ok(c);
+        }
+        let skip = c.period * (1e3f64.ln() / c.max_multiplier.ln()).min(1e6);
+        let t_here = t + settled;
+        let mut sopts = opts.solver;
+        sopts.rtol = sopts.rtol.max(opts.settle_rtol);
+        sopts.max_steps = opts.settle_steps;
+        let mut sol = Solver::new(sys, t_here, c.z0, t_here + skip, sopts)?;
+        while sol.step()?.is_some() {}
+        spent += skip;
+        t = sol.t();
+        z = *sol.state();
+        if spent >= opts.settle_time {
+            let mut c = c;
+            c.settle_time = spent;
+            return Ok(c);
+        }
+    }
+}
+
+/// One settling run from `(t0, z0)` and the shooting that follows it.
+fn settle_and_shoot<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    t0: f64,
+    z0: [f64; N],
+    opts: &CycleOptions,
+) -> Result<(Cycle<N>, f64), CycleError> {
+    // A settling run at the looser settle_rtol that fails (chatter the
+    // tighter tolerance resolves, say) is repeated at the solver's own.
+    let (section, z, period, settled) = match settle(sys, t0, z0, opts) {
+        Err(CycleError::Integrate(_)) if opts.settle_rtol > opts.solver.rtol => {
+            let mut strict = *opts;
+            strict.settle_rtol = opts.solver.rtol;
+            settle(sys, t0, z0, &strict)?
+        }
+        other => other?,
+    };
+    let c = shoot(sys, z, period, section, opts)?;
+    Ok((c, settled))
+}
+
+/// Newton shooting from a guess `(z0, period)` on `section`, then the multipliers.
+pub fn shoot<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    z0: [f64; N],
+    period: f64,
+    section: Section,
+    opts: &CycleOptions,
+) -> Result<Cycle<N>, CycleError> {
+    if section.index >= N {
+        return Err(CycleError::Bad(format!(
+            "section index {} out of range",
+            section.index
+        )));
+    }
+    if !(period > 0.0 && period.is_finite()) {
+        return Err(CycleError::Bad(format!("period guess {period}")));
+    }
+    let mut z = z0;
+    let mut t = period;
+    // Scales from a first pass.
+    let first = period_flow(sys, &z, t, &[1.0; N], opts, false, None)?;
+    let mut amp = [0.0; N];
+    for i in 0..N {
+        amp[i] = 0.5 * (first.hi[i] - first.lo[i]);
+    }
+    let s = block_scales(&amp, &opts.solver);
+    let mut iterations = 0;
+    let mut residual;
+    let mut last_step = f64::INFINITY;
+    loop {
+        let p = period_flow(sys, &z, t, &s, opts, true, None)?;
+        residual = (0..N)
+            .map(|i| ((p.z_end[i] - z[i]) / s[i]).abs())
+            .fold(0.0, f64::max);
+        if residual <= opts.newton_tol
+            || (iterations >= 3 && last_step <= 1e-12 && residual <= 1e3 * opts.newton_tol)
+        {
+            return finish(sys, z, t, section, s, residual, iterations, p);
+        }
+        if iterations >= opts.newton_iterations {
+            return Err(CycleError::Shooting(format!(
+                "residual {residual:.3e} after {iterations} Newton iterations (period {t:.9e} s)"
+            )));
+        }
+        iterations += 1;
+        let mut f = [0.0; N];
+        let t_end = autonomous_from(sys) + t;
+        let modes = sys.start_modes(t_end, &p.z_end);
+        sys.field(t_end, &modes, &p.z_end, &mut f);
+        let mut a = DMatrix::<f64>::zeros(N + 1, N + 1);
+        let mut b = nalgebra::DVector::<f64>::zeros(N + 1);
+        for i in 0..N {
+            for j in 0..N {
+                a[(i, j)] = p.m[(i, j)] - if i == j { 1.0 } else { 0.0 };
+            }
+            a[(i, N)] = f[i] / s[i] * t;
+            b[i] = -(p.z_end[i] - z[i]) / s[i];
+        }
+        a[(N, section.index)] = 1.0;
+        b[N] = -(z[section.index] - section.level) / s[section.index];
+        let dx = a.lu().solve(&b).ok_or_else(|| {
+            CycleError::Shooting(format!("the shooting matrix is singular (t = {t:.6e} s)"))
+        })?;
+        // Damped: never move the period by more than a third.
+        let mut lambda = 1.0f64;
+        if (dx[N]).abs() > 1.0 / 3.0 {
+            lambda = (1.0 / 3.0) / dx[N].abs();
+        }
+        for i in 0..N {
+            z[i] += lambda * dx[i] * s[i];
+        }
+        z[section.index] = section.level;
+        t *= 1.0 + lambda * dx[N];
+        last_step = dx.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if !last_step.is_finite() {
+            return Err(CycleError::Shooting("Newton step not finite".into()));
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn finish<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    z: [f64; N],
+    t: f64,
+    section: Section,
+    s: [f64; N],
+    residual: f64,
+    iterations: usize,
+    p: Period<N>,
+) -> Result<Cycle<N>, CycleError> {
+    let mut f = [0.0; N];
+    let t_a = autonomous_from(sys);
+    let modes = sys.start_modes(t_a, &z);
+    sys.field(t_a, &modes, &z, &mut f);
+    let fs = nalgebra::DVector::from_fn(N, |i, _| f[i] / s[i]);
+    let k = section.index;
+    let (multipliers, max_multiplier) = multipliers_of(&p.m, &fs, k);
+    let mut monodromy = [[0.0; N]; N];
+    for i in 0..N {
+        for j in 0..N {
+            monodromy[i][j] = p.m[(i, j)] * s[i] / s[j];
+        }
+    }
+    let mut amplitude = [0.0; N];
+    for i in 0..N {
+        amplitude[i] = 0.5 * (p.hi[i] - p.lo[i]);
+    }
+    let _ = sys;
+    Ok(Cycle {
+        period: t,
+        z0: z,
+        section,
+        monodromy,
+        stable: max_multiplier < 1.0,
+        max_multiplier,
+        multipliers,
+        residual,
+        iterations,
+        events_per_period: p.events,
+        amplitude,
+        settle_time: 0.0,
+    })
+}
+
+/// The multipliers of a (scaled) monodromy `m` with flow vector `f` on the
+/// section `z_k = c`: the trivial one and the eigenvalues of the Poincaré
+/// map's Jacobian (module documentation).
+fn multipliers_of(
+    m: &DMatrix<f64>,
+    f: &nalgebra::DVector<f64>,
+    k: usize,
+) -> (Vec<Multiplier>, f64) {
+    let n = m.nrows();
+    let mf = m * f;
+    let trivial = mf.dot(f) / f.dot(f);
+    let mut proj = DMatrix::<f64>::identity(n, n);
+    if f[k] != 0.0 {
+        for i in 0..n {
+            proj[(i, k)] -= f[i] / f[k];
+        }
+    }
+    let poincare = proj * m;
+    let ev = poincare.complex_eigenvalues();
+    let mut list: Vec<Multiplier> = ev
+        .iter()
+        .map(|c| Multiplier {
+            re: c.re,
+            im: c.im,
+            trivial: false,
+        })
+        .collect();
+    // The section's own direction: the eigenvalue nearest zero stands for the flow.
+    let zero = (0..n)
+        .min_by(|&a, &b| list[a].abs().total_cmp(&list[b].abs()))
+        .unwrap_or(0);
+    list[zero] = Multiplier {
+        re: trivial,
+        im: 0.0,
+        trivial: true,
+    };
+    let max = list
+        .iter()
+        .filter(|m| !m.trivial)
+        .map(Multiplier::abs)
+        .fold(0.0, f64::max);
+    sort_multipliers(&mut list);
+    (list, max)
+}
+
+/// Sort by modulus descending, then real part, then imaginary part.
+fn sort_multipliers(list: &mut [Multiplier]) {
+    list.sort_by(|a, b| {
+        b.abs()
+            .total_cmp(&a.abs())
+            .then(b.re.total_cmp(&a.re))
+            .then(b.im.total_cmp(&a.im))
+    });
+}
+
+/// Sample one period of `cycle` densely (integrator steps, 8 points each, and
+/// every event as two rows: the state before and after it).
+pub fn orbit<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    cycle: &Cycle<N>,
+    opts: &CycleOptions,
+) -> Result<Orbit<N>, CycleError> {
+    let mut o = Orbit::default();
+    period_flow(
+        sys,
+        &cycle.z0,
+        cycle.period,
+        &[1.0; N],
+        opts,
+        false,
+        Some(&mut o),
+    )?;
+    Ok(o)
+}
+
+/// The monodromy matrix by finite differences through the event-driven flow:
+/// column `j` is `(φ_T(z₀ + h_j e_j) − φ_T(z₀ − h_j e_j)) / 2h_j` with
+/// `h_j = rel · scale_j` (scales as in the module documentation). An
+/// independent check of the saltation-based monodromy.
+pub fn finite_difference_monodromy<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    cycle: &Cycle<N>,
+    rel: f64,
+    solver: SolverOptions,
+) -> Result<[[f64; N]; N], CycleError> {
+    let s = block_scales(&cycle.amplitude, &solver);
+    let end = |z: [f64; N]| -> Result<[f64; N], CycleError> {
+        let t_a = autonomous_from(sys);
+        let mut sol = Solver::new(sys, t_a, z, t_a + cycle.period, solver)?;
+        while sol.step()?.is_some() {}
+        Ok(*sol.state())
+    };
+    let mut m = [[0.0; N]; N];
+    for j in 0..N {
+        let h = rel * s[j];
+        let mut zp = cycle.z0;
+        zp[j] += h;
+        let mut zm = cycle.z0;
+        zm[j] -= h;
+        let (ep, em) = (end(zp)?, end(zm)?);
+        for i in 0..N {
+            m[i][j] = (ep[i] - em[i]) / (zp[j] - zm[j]);
+        }
+    }
+    Ok(m)
+}
+
+/// The state scales used for `cycle`'s norms (positions by the largest
+/// position amplitude, velocities by the largest velocity amplitude).
+pub fn scales<const N: usize>(cycle: &Cycle<N>, solver: &SolverOptions) -> [f64; N] {
+    block_scales(&cycle.amplitude, solver)
+}

@@ -1,0 +1,2018 @@
+//! General lumped mechanical models with several frictional contacts, built
+//! from a description ([`LumpedSpec`]) rather than written in Rust.
+//!
+//! Degrees of freedom `q` (named), masses (a diagonal, and/or a full
+//! symmetric positive definite matrix `M`), springs on linear combinations of
+//! dofs, stiffness and damping matrices `K`, `C`, constant (or ramped) forces
+//! and up to [`MAX_CONTACTS`] frictional [`Contact`]s:
+//!
+//! ```text
+//! M q̈ = F(t) − K q − C q̇ − Σ_springs (k e + c ė) a − Σ_contacts (F_n n + F_t t − F_f n)
+//! ```
+//!
+//! with `e = a·q` per spring, and per contact the compression `δ = n·q`,
+//! `F_n = k δ + c δ̇` (or a prescribed load), sliding velocity `v = V + t·q̇`,
+//! friction `F_t = μ(|v|) F_n sign(v)` in slip and follower force
+//! `F_f = α F_t (s·q)`.
+//!
+//! **Sticking contacts** are constraints `t_i·q̈ = 0`: their friction forces
+//! `λ` (Lagrange multipliers) solve one small linear system
+//! `Σ_k (t_j M⁻¹ w_k) λ_k = t_j M⁻¹ f` with `w_k = t_k − α_k (s_k·q) n_k`,
+//! `f` the force without them. A contact leaves stick when its own multiplier
+//! exceeds `μ_s F_n` in either direction. The constraint set of all contacts
+//! is checked once, when the model is built: if the tangents are linearly
+//! dependent in the metric `M⁻¹` (a redundant or contradictory set), the
+//! model is refused naming the contacts, so every subset is regular.
+//!
+//! **Guards.** Slip reversal, separation and recontact are affine in the
+//! state. A stick-break guard is affine too unless another contact slips with
+//! velocity-dependent friction (its multiplier then contains `μ(v)` of the
+//! other contact), a bilateral contact slips, or a force is ramped; such
+//! guards are evaluated exactly and searched with a Lipschitz bound
+//! ([`System::guard_slope_bound`]), so no crossing is missed either.
+//!
+//! State `z = (q, q̇)`; positions named after the dofs, velocities `v<dof>`.
+
+use super::contact::{Combination, Contact, Normal};
+use super::{
+    EventKind, Guard, GuardKind, Guards, Mode, ModelError, Modes, Observables, System, MAX_CONTACTS,
+};
+use crate::friction::FrictionLaw;
+use crate::params::ParamError;
+use nalgebra::DMatrix;
+
+/// A bad model description: one line naming the element and key.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct SpecError(pub String);
+
+fn bad<T>(msg: impl Into<String>) -> Result<T, SpecError> {
+    Err(SpecError(msg.into()))
+}
+
+/// A matrix as coordinate triplets (0-based), e.g. read from Matrix Market.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Triplets {
+    /// Rows.
+    pub rows: usize,
+    /// Columns.
+    pub cols: usize,
+    /// `(row, col, value)`; repeated entries add up.
+    pub entries: Vec<(usize, usize, f64)>,
+}
+
+/// A square sparse matrix in compressed rows.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Sparse {
+    /// Size.
+    pub n: usize,
+    row_ptr: Vec<usize>,
+    col: Vec<usize>,
+    val: Vec<f64>,
+}
+
+impl Sparse {
+    /// From triplets (duplicates summed, zeros dropped).
+    pub fn from_triplets(t: &Triplets) -> Sparse {
+        let n = t.rows;
+        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+        for &(r, c, v) in &t.entries {
+            rows[r].push((c, v));
+        }
+        let mut s = Sparse {
+            n,
+            row_ptr: vec![0],
+            col: Vec::new(),
+            val: Vec::new(),
+        };
+        for mut row in rows {
+            row.sort_by_key(|e| e.0);
+            let mut merged: Vec<(usize, f64)> = Vec::new();
+            for (c, v) in row {
+                match merged.last_mut() {
+                    Some(last) if last.0 == c => last.1 += v,
+                    _ => merged.push((c, v)),
+                }
+            }
+            for (c, v) in merged.into_iter().filter(|e| e.1 != 0.0) {
+                s.col.push(c);
+                s.val.push(v);
+            }
+            s.row_ptr.push(s.col.len());
+        }
+        s
+    }
+    /// `out += a·(A x)`.
+    #[inline]
+    pub fn mul_add(&self, x: &[f64], out: &mut [f64], a: f64) {
+        for r in 0..self.n {
+            let mut s = 0.0;
+            for k in self.row_ptr[r]..self.row_ptr[r + 1] {
+                s += self.val[k] * x[self.col[k]];
+            }
+            out[r] += a * s;
+        }
+    }
+    /// Entry `(r, c)`.
+    pub fn get(&self, r: usize, c: usize) -> f64 {
+        (self.row_ptr[r]..self.row_ptr[r + 1])
+            .find(|&k| self.col[k] == c)
+            .map_or(0.0, |k| self.val[k])
+    }
+    /// Non-zero entries `(row, col, value)`.
+    pub fn entries(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
+        (0..self.n).flat_map(move |r| {
+            (self.row_ptr[r]..self.row_ptr[r + 1]).map(move |k| (r, self.col[k], self.val[k]))
+        })
+    }
+    /// Whether only diagonal entries are non-zero.
+    pub fn is_diagonal(&self) -> bool {
+        self.entries().all(|(r, c, _)| r == c)
+    }
+}
+
+/// A linear spring–damper on `e = on·q`: generalised force `−(k e + c ė)·on`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spring {
+    /// Element name.
+    pub name: String,
+    /// The elongation's coefficients.
+    pub on: Combination,
+    /// Stiffness (N/m).
+    pub k: f64,
+    /// Damping (kg/s).
+    pub c: f64,
+}
+
+/// A constant generalised force `value·on`, optionally ramped up linearly over `ramp` seconds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Force {
+    /// Element name.
+    pub name: String,
+    /// Where it acts.
+    pub on: Combination,
+    /// Value (N).
+    pub value: f64,
+    /// Ramp time (s); 0: a step at t = 0.
+    pub ramp: f64,
+}
+
+impl Force {
+    /// Factor of the value at time `t` (1 after the ramp).
+    #[inline]
+    pub fn factor(&self, t: f64) -> f64 {
+        if self.ramp > 0.0 && t < self.ramp {
+            (t / self.ramp).max(0.0)
+        } else {
+            1.0
+        }
+    }
+}
+
+/// A dof combination as written by users: `(dof name, coefficient)`.
+pub type Terms = Vec<(String, f64)>;
+
+/// Description of a spring.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpringSpec {
+    /// Element name.
+    pub name: String,
+    /// `on`.
+    pub on: Terms,
+    /// `k` (N/m).
+    pub k: f64,
+    /// `c` (kg/s).
+    pub c: f64,
+}
+
+/// Description of a force.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForceSpec {
+    /// Element name.
+    pub name: String,
+    /// `on`.
+    pub on: Terms,
+    /// `value` (N).
+    pub value: f64,
+    /// `ramp` (s).
+    pub ramp: f64,
+}
+
+/// Description of a contact (the keys of a `[[contact]]` table).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactSpec {
+    /// Element name.
+    pub name: String,
+    /// `normal`: the compression's coefficients (with `k`, `c`).
+    pub normal: Option<Terms>,
+    /// `k` (N/m).
+    pub k: Option<f64>,
+    /// `c` (kg/s).
+    pub c: Option<f64>,
+    /// `contact`: unilateral (default) or bilateral.
+    pub bilateral: bool,
+    /// `normal_force`: a prescribed load instead of `normal`/`k`/`c`.
+    pub normal_force: Option<f64>,
+    /// `tangent`.
+    pub tangent: Option<Terms>,
+    /// `V` (m/s).
+    pub v: f64,
+    /// The friction law with its parameters.
+    pub friction: FrictionLaw,
+    /// `alpha` (1/m).
+    pub alpha: f64,
+    /// `slope`.
+    pub slope: Terms,
+}
+
+/// Everything a lumped model is built from.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LumpedSpec {
+    /// Dof names, in state order.
+    pub dofs: Vec<String>,
+    /// `[masses]`: dof → mass (kg), added to the diagonal of `M`.
+    pub masses: Vec<(String, f64)>,
+    /// Mass matrix (symmetric positive definite with the masses added).
+    pub m: Option<Triplets>,
+    /// Stiffness matrix.
+    pub k: Option<Triplets>,
+    /// Damping matrix.
+    pub c: Option<Triplets>,
+    /// Springs.
+    pub springs: Vec<SpringSpec>,
+    /// Forces.
+    pub forces: Vec<ForceSpec>,
+    /// Contacts.
+    pub contacts: Vec<ContactSpec>,
+}
+
+/// `M⁻¹`: diagonal, or dense row-major.
+#[derive(Debug, Clone, PartialEq)]
+enum InvMass {
+    Diagonal(Vec<f64>),
+    Dense(Vec<f64>),
+}
+
+/// A lumped model (see the module docs). Build it with [`Lumped::build`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Lumped {
+    dofs: Vec<String>,
+    states: Vec<String>,
+    /// Diagonal masses from `[masses]` (0 where only `M` gives one).
+    masses: Vec<f64>,
+    m_matrix: Option<Sparse>,
+    k_matrix: Option<Sparse>,
+    c_matrix: Option<Sparse>,
+    /// Springs.
+    pub springs: Vec<Spring>,
+    /// Forces.
+    pub forces: Vec<Force>,
+    /// Contacts.
+    pub contacts: Vec<Contact>,
+    // Derived from the above by `refresh`.
+    inv_mass: InvMass,
+    /// `M⁻¹ t_j` per contact, dense.
+    minv_t: Vec<Vec<f64>>,
+    /// `t_i·M⁻¹ t_j`.
+    gram: [[f64; MAX_CONTACTS]; MAX_CONTACTS],
+    /// `t_i·M⁻¹ n_j`.
+    tn: [[f64; MAX_CONTACTS]; MAX_CONTACTS],
+    has_ramp: bool,
+}
+
+/// Up to this many dofs, guard evaluations use a stack buffer (no allocation).
+const STACK_DOFS: usize = 64;
+
+/// Keys of a spring, force and contact (beside the friction law's).
+pub const SPRING_KEYS: [&str; 2] = ["k", "c"];
+/// See [`SPRING_KEYS`].
+pub const FORCE_KEYS: [&str; 2] = ["value", "ramp"];
+
+/// The small dense solve `G x = b` (`k ≤ MAX_CONTACTS`), Gaussian elimination
+/// with partial pivoting on stack arrays. `false` if `G` is singular.
+fn solve_small(
+    g: &mut [[f64; MAX_CONTACTS]; MAX_CONTACTS],
+    b: &mut [f64; MAX_CONTACTS],
+    k: usize,
+) -> bool {
+    for col in 0..k {
+        let mut p = col;
+        for r in col + 1..k {
+            if g[r][col].abs() > g[p][col].abs() {
+                p = r;
+            }
+        }
+        if g[p][col] == 0.0 || !g[p][col].is_finite() {
+            return false;
+        }
+        g.swap(col, p);
+        b.swap(col, p);
+        for r in col + 1..k {
+            let f = g[r][col] / g[col][col];
+            if f != 0.0 {
+                for c in col..k {
+                    g[r][c] -= f * g[col][c];
+                }
+                b[r] -= f * b[col];
+            }
+        }
+    }
+    for col in (0..k).rev() {
+        let mut s = b[col];
+        for c in col + 1..k {
+            s -= g[col][c] * b[c];
+        }
+        b[col] = s / g[col][col];
+    }
+    true
+}
+
+/// The contacts sticking in `modes`, in order, and how many.
+#[inline]
+fn stick_set(modes: &Modes) -> ([usize; MAX_CONTACTS], usize) {
+    let mut s = [0; MAX_CONTACTS];
+    let mut k = 0;
+    for (i, m) in modes.as_slice().iter().enumerate() {
+        if *m == Mode::Stick {
+            s[k] = i;
+            k += 1;
+        }
+    }
+    (s, k)
+}
+
+impl Lumped {
+    /// Build and validate a model. Every error names the element and key
+    /// (`spring 'disc_x': on: unknown dof 'x_q'`).
+    pub fn build(spec: &LumpedSpec) -> Result<Lumped, SpecError> {
+        let n = spec.dofs.len();
+        if n == 0 {
+            return bad("dofs: the model needs at least one dof");
+        }
+        for (i, d) in spec.dofs.iter().enumerate() {
+            if d.is_empty() || d.contains(['.', '=', ',', ' ']) {
+                return bad(format!(
+                    "dofs: '{d}' is not a valid dof name (no '.', '=', ',' or spaces)"
+                ));
+            }
+            if spec.dofs[..i].contains(d) {
+                return bad(format!("dofs: '{d}' is listed twice"));
+            }
+        }
+        let dof = |what: &str, key: &str, name: &str| -> Result<usize, SpecError> {
+            spec.dofs
+                .iter()
+                .position(|d| d == name)
+                .ok_or_else(|| SpecError(format!("{what}: {key}: unknown dof '{name}'")))
+        };
+        let combo = |what: &str, key: &str, terms: &Terms| -> Result<Combination, SpecError> {
+            let mut c = Combination::default();
+            for (name, v) in terms {
+                let i = dof(what, key, name)?;
+                if !v.is_finite() {
+                    return bad(format!(
+                        "{what}: {key}.{name} = {v}: must be a finite number"
+                    ));
+                }
+                if c.idx.contains(&i) {
+                    return bad(format!("{what}: {key}: dof '{name}' given twice"));
+                }
+                if *v != 0.0 {
+                    c.idx.push(i);
+                    c.coef.push(*v);
+                }
+            }
+            Ok(c)
+        };
+        let mut masses = vec![0.0; n];
+        for (name, m) in &spec.masses {
+            let i = dof("masses", name, name).map_err(|_| {
+                SpecError(format!(
+                    "masses: unknown dof '{name}' (dofs: {})",
+                    spec.dofs.join(", ")
+                ))
+            })?;
+            if !(m.is_finite() && *m > 0.0) {
+                return bad(format!(
+                    "masses: {name} = {m}: a mass must be a finite number > 0 (kg)"
+                ));
+            }
+            masses[i] = *m;
+        }
+        let matrix = |key: &str, t: &Option<Triplets>| -> Result<Option<Sparse>, SpecError> {
+            let Some(t) = t else { return Ok(None) };
+            if t.rows != t.cols {
+                return bad(format!(
+                    "matrices: {key} is {}×{}, not square",
+                    t.rows, t.cols
+                ));
+            }
+            if t.rows != n {
+                return bad(format!(
+                    "matrices: {key} is {}×{} but the model has {n} dofs",
+                    t.rows, t.cols
+                ));
+            }
+            if let Some(e) = t.entries.iter().find(|e| !e.2.is_finite()) {
+                return bad(format!(
+                    "matrices: {key}[{}, {}] = {}: must be finite",
+                    e.0 + 1,
+                    e.1 + 1,
+                    e.2
+                ));
+            }
+            Ok(Some(Sparse::from_triplets(t)))
+        };
+        let m_matrix = matrix("M", &spec.m)?;
+        let k_matrix = matrix("K", &spec.k)?;
+        let c_matrix = matrix("C", &spec.c)?;
+        if let Some(m) = &m_matrix {
+            for (r, c, v) in m.entries() {
+                let w = m.get(c, r);
+                if (v - w).abs() > 1e-12 * v.abs().max(w.abs()) {
+                    return bad(format!(
+                        "matrices: M is not symmetric: M[{}, {}] = {v} but M[{}, {}] = {w}",
+                        r + 1,
+                        c + 1,
+                        c + 1,
+                        r + 1
+                    ));
+                }
+            }
+        }
+        if m_matrix.is_none() {
+            if let Some(i) = masses.iter().position(|m| *m <= 0.0) {
+                return bad(format!(
+                    "masses: dof '{}' has no mass (give one per dof, or a mass matrix)",
+                    spec.dofs[i]
+                ));
+            }
+        }
+        let mut names: Vec<String> = Vec::new();
+        let mut name_ok = |kind: &str, name: &str| -> Result<(), SpecError> {
+            if name.is_empty() || name.contains(['.', '=', ',', ' ']) {
+                return bad(format!(
+                    "{kind} '{name}': name: not a valid element name (no '.', '=', ',' or spaces)"
+                ));
+            }
+            if name == "mass" || names.iter().any(|x| x == name) {
+                return bad(format!(
+                    "{kind} '{name}': name: already used (element names must be unique and not 'mass')"
+                ));
+            }
+            names.push(name.to_string());
+            Ok(())
+        };
+        let mut springs = Vec::new();
+        for s in &spec.springs {
+            let what = format!("spring '{}'", s.name);
+            name_ok("spring", &s.name)?;
+            let on = combo(&what, "on", &s.on)?;
+            if on.is_empty() {
+                return bad(format!(
+                    "{what}: on: needs at least one dof with a non-zero coefficient"
+                ));
+            }
+            for (key, v) in [("k", s.k), ("c", s.c)] {
+                if !(v.is_finite() && v >= 0.0) {
+                    return bad(format!("{what}: {key} = {v}: must be a finite number ≥ 0"));
+                }
+            }
+            springs.push(Spring {
+                name: s.name.clone(),
+                on,
+                k: s.k,
+                c: s.c,
+            });
+        }
+        let mut forces = Vec::new();
+        for f in &spec.forces {
+            let what = format!("force '{}'", f.name);
+            name_ok("force", &f.name)?;
+            let on = combo(&what, "on", &f.on)?;
+            if !f.value.is_finite() {
+                return bad(format!(
+                    "{what}: value = {}: must be a finite number",
+                    f.value
+                ));
+            }
+            if !(f.ramp.is_finite() && f.ramp >= 0.0) {
+                return bad(format!(
+                    "{what}: ramp = {}: must be a finite number ≥ 0 (s)",
+                    f.ramp
+                ));
+            }
+            forces.push(Force {
+                name: f.name.clone(),
+                on,
+                value: f.value,
+                ramp: f.ramp,
+            });
+        }
+        if spec.contacts.len() > MAX_CONTACTS {
+            return bad(format!(
+                "contact '{}': at most {MAX_CONTACTS} contacts are supported",
+                spec.contacts[MAX_CONTACTS].name
+            ));
+        }
+        let mut contacts = Vec::new();
+        for c in &spec.contacts {
+            let what = format!("contact '{}'", c.name);
+            name_ok("contact", &c.name)?;
+            let Some(tangent) = &c.tangent else {
+                return bad(format!("{what}: tangent: missing (the sliding direction, e.g. tangent = {{ x_d = 1.0, x_p = -1.0 }})"));
+            };
+            let tangent = combo(&what, "tangent", tangent)?;
+            if tangent.is_empty() {
+                return bad(format!(
+                    "{what}: tangent: needs at least one dof with a non-zero coefficient"
+                ));
+            }
+            let normal = match (&c.normal, c.normal_force) {
+                (Some(_), Some(_)) => {
+                    return bad(format!(
+                        "{what}: normal_force: give either normal (with k, c) or normal_force, not both"
+                    ))
+                }
+                (None, None) => {
+                    return bad(format!(
+                        "{what}: normal: missing (normal with k and c, or normal_force)"
+                    ))
+                }
+                (None, Some(f)) => {
+                    if !(f.is_finite() && f >= 0.0) {
+                        return bad(format!("{what}: normal_force = {f}: must be a finite number ≥ 0 (N)"));
+                    }
+                    if c.k.is_some() || c.c.is_some() {
+                        return bad(format!("{what}: k: a prescribed normal_force takes no k or c"));
+                    }
+                    Normal::Prescribed(f)
+                }
+                (Some(terms), None) => {
+                    let normal = combo(&what, "normal", terms)?;
+                    if normal.is_empty() {
+                        return bad(format!("{what}: normal: needs at least one dof with a non-zero coefficient"));
+                    }
+                    let k = c.k.ok_or_else(|| SpecError(format!("{what}: k: missing (the contact stiffness, N/m)")))?;
+                    let cc = c.c.unwrap_or(0.0);
+                    for (key, v) in [("k", k), ("c", cc)] {
+                        if !(v.is_finite() && v >= 0.0) {
+                            return bad(format!("{what}: {key} = {v}: must be a finite number ≥ 0"));
+                        }
+                    }
+                    Normal::Elastic {
+                        normal,
+                        k,
+                        c: cc,
+                        bilateral: c.bilateral,
+                    }
+                }
+            };
+            if !c.v.is_finite() {
+                return bad(format!(
+                    "{what}: V = {}: must be a finite number (m/s)",
+                    c.v
+                ));
+            }
+            if !c.alpha.is_finite() {
+                return bad(format!(
+                    "{what}: alpha = {}: must be a finite number (1/m)",
+                    c.alpha
+                ));
+            }
+            c.friction
+                .validate()
+                .map_err(|e| SpecError(format!("{what}: {}", prefixed(&c.name, e))))?;
+            let slope = combo(&what, "slope", &c.slope)?;
+            if c.alpha != 0.0 && matches!(normal, Normal::Prescribed(_)) {
+                return bad(format!(
+                    "{what}: alpha = {}: a follower force needs a normal (not a prescribed normal_force)",
+                    c.alpha
+                ));
+            }
+            contacts.push(Contact {
+                name: c.name.clone(),
+                normal,
+                tangent,
+                v: c.v,
+                friction: c.friction,
+                alpha: c.alpha,
+                slope,
+            });
+        }
+        let mut model = Lumped {
+            states: spec
+                .dofs
+                .iter()
+                .cloned()
+                .chain(spec.dofs.iter().map(|d| format!("v{d}")))
+                .collect(),
+            dofs: spec.dofs.clone(),
+            masses,
+            m_matrix,
+            k_matrix,
+            c_matrix,
+            springs,
+            forces,
+            contacts,
+            inv_mass: InvMass::Diagonal(Vec::new()),
+            minv_t: Vec::new(),
+            gram: [[0.0; MAX_CONTACTS]; MAX_CONTACTS],
+            tn: [[0.0; MAX_CONTACTS]; MAX_CONTACTS],
+            has_ramp: false,
+        };
+        model.refresh()?;
+        Ok(model)
+    }
+
+    /// Recompute what derives from the parameters (M⁻¹, the constraint
+    /// metric) and check the stick constraints.
+    fn refresh(&mut self) -> Result<(), SpecError> {
+        let n = self.dofs.len();
+        self.has_ramp = self.forces.iter().any(|f| f.ramp > 0.0);
+        self.inv_mass = match &self.m_matrix {
+            Some(m) if !m.is_diagonal() => {
+                let mut full = DMatrix::from_fn(n, n, |r, c| m.get(r, c));
+                for i in 0..n {
+                    full[(i, i)] += self.masses[i];
+                }
+                let chol = full.cholesky().ok_or_else(|| {
+                    SpecError(
+                        "matrices: M (with the [masses] added) is not positive definite".into(),
+                    )
+                })?;
+                let inv = chol.inverse();
+                InvMass::Dense((0..n * n).map(|k| inv[(k / n, k % n)]).collect())
+            }
+            _ => {
+                let mut inv = Vec::with_capacity(n);
+                for i in 0..n {
+                    let m = self.masses[i] + self.m_matrix.as_ref().map_or(0.0, |m| m.get(i, i));
+                    if !(m > 0.0 && m.is_finite()) {
+                        return bad(format!(
+                            "matrices: M[{}, {}] = {m}: the mass of dof '{}' must be > 0",
+                            i + 1,
+                            i + 1,
+                            self.dofs[i]
+                        ));
+                    }
+                    inv.push(1.0 / m);
+                }
+                InvMass::Diagonal(inv)
+            }
+        };
+        let nc = self.contacts.len();
+        self.minv_t = self
+            .contacts
+            .iter()
+            .map(|c| self.apply_inv_mass_vec(&c.tangent.dense(n)))
+            .collect();
+        for i in 0..nc {
+            for j in 0..nc {
+                self.gram[i][j] = self.contacts[j].tangent.dot(&self.minv_t[i]);
+                self.tn[i][j] = match &self.contacts[j].normal {
+                    Normal::Elastic { normal, .. } => normal.dot(&self.minv_t[i]),
+                    Normal::Prescribed(_) => 0.0,
+                };
+            }
+        }
+        // A follower force along n_j must not enter another contact's stick
+        // constraint (it would make the constraint matrix depend on q).
+        for j in 0..nc {
+            if self.contacts[j].alpha == 0.0 {
+                continue;
+            }
+            for i in 0..nc {
+                let scale = (self.gram[i][i] * self.gram[j][j]).sqrt();
+                if self.tn[i][j].abs() > 1e-12 * scale {
+                    return bad(format!(
+                        "contact '{}': alpha: a follower force along the normal of '{}' acts on the tangent of '{}' (through the masses); squeal supports follower forces only where they do not",
+                        self.contacts[j].name, self.contacts[j].name, self.contacts[i].name
+                    ));
+                }
+            }
+        }
+        // The stick constraints of all contacts together must be independent
+        // (then every subset is): Cholesky of the Gram matrix, contact by contact.
+        let mut l = [[0.0; MAX_CONTACTS]; MAX_CONTACTS];
+        for i in 0..nc {
+            for j in 0..=i {
+                let mut s = self.gram[i][j];
+                for k in 0..j {
+                    s -= l[i][k] * l[j][k];
+                }
+                if i == j {
+                    if s <= 1e-10 * self.gram[i][i] {
+                        let others: Vec<String> = (0..i)
+                            .filter(|&k| {
+                                self.gram[i][k].abs()
+                                    > 1e-12 * (self.gram[i][i] * self.gram[k][k]).sqrt()
+                            })
+                            .map(|k| format!("'{}'", self.contacts[k].name))
+                            .collect();
+                        return bad(format!(
+                            "contact '{}': tangent: its stick constraint is redundant with {} (the tangents are linearly dependent, so the stick forces are not determined)",
+                            self.contacts[i].name,
+                            if others.is_empty() { "the other contacts'".to_string() } else { others.join(" and ") }
+                        ));
+                    }
+                    l[i][i] = s.sqrt();
+                } else {
+                    l[i][j] = s / l[j][j];
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// `M⁻¹ x` (allocating; for set-up).
+    fn apply_inv_mass_vec(&self, x: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; x.len()];
+        self.apply_inv_mass(x, &mut out);
+        out
+    }
+
+    /// `out = M⁻¹ x`.
+    #[inline]
+    fn apply_inv_mass(&self, x: &[f64], out: &mut [f64]) {
+        match &self.inv_mass {
+            InvMass::Diagonal(inv) => {
+                for i in 0..inv.len() {
+                    out[i] = x[i] * inv[i];
+                }
+            }
+            InvMass::Dense(inv) => {
+                let n = x.len();
+                for r in 0..n {
+                    let row = &inv[r * n..(r + 1) * n];
+                    out[r] = row.iter().zip(x).map(|(a, b)| a * b).sum();
+                }
+            }
+        }
+    }
+
+    /// Number of dofs.
+    pub fn dof_count(&self) -> usize {
+        self.dofs.len()
+    }
+    /// Dof names.
+    pub fn dofs(&self) -> &[String] {
+        &self.dofs
+    }
+    /// State names: the dofs, then `v<dof>`.
+    pub fn state_names(&self) -> &[String] {
+        &self.states
+    }
+    /// The mass on each dof's diagonal (for energy-weighted mode attribution).
+    pub fn diagonal_masses(&self) -> Vec<f64> {
+        (0..self.dofs.len())
+            .map(|i| self.masses[i] + self.m_matrix.as_ref().map_or(0.0, |m| m.get(i, i)))
+            .collect()
+    }
+
+    /// Generalised force without the stick multipliers:
+    /// `F(t) − K q − C q̇ − springs − contacts` (slip friction only if
+    /// `slip_friction`), into `acc[..n]`.
+    #[inline]
+    fn base_force(
+        &self,
+        t: f64,
+        modes: &Modes,
+        q: &[f64],
+        u: &[f64],
+        acc: &mut [f64],
+        slip_friction: bool,
+    ) {
+        acc.fill(0.0);
+        for f in &self.forces {
+            f.on.add_scaled(acc, f.value * f.factor(t));
+        }
+        for s in &self.springs {
+            let e = s.on.dot(q);
+            let ed = s.on.dot(u);
+            s.on.add_scaled(acc, -(s.k * e + s.c * ed));
+        }
+        if let Some(k) = &self.k_matrix {
+            k.mul_add(q, acc, -1.0);
+        }
+        if let Some(c) = &self.c_matrix {
+            c.mul_add(u, acc, -1.0);
+        }
+        for (i, c) in self.contacts.iter().enumerate() {
+            let mode = modes.get(i);
+            if mode == Mode::Free {
+                continue;
+            }
+            let f_n = c.normal_force(q, u);
+            if let Normal::Elastic { normal, .. } = &c.normal {
+                normal.add_scaled(acc, -f_n);
+            }
+            if slip_friction && mode != Mode::Stick {
+                let f_t = c.slip_force(mode, c.sliding_velocity(u), f_n);
+                c.tangent.add_scaled(acc, -f_t);
+                if c.alpha != 0.0 {
+                    if let Normal::Elastic { normal, .. } = &c.normal {
+                        normal.add_scaled(acc, c.alpha * f_t * c.slope.dot(q));
+                    }
+                }
+            }
+        }
+    }
+
+    /// The stick multipliers (friction forces of the sticking contacts, in
+    /// the order of `set`) for the force `acc` without them. `false` if the
+    /// constraint matrix is singular.
+    #[inline]
+    fn multipliers(
+        &self,
+        set: &[usize],
+        q: &[f64],
+        acc: &[f64],
+        lambda: &mut [f64; MAX_CONTACTS],
+    ) -> bool {
+        let k = set.len();
+        let mut g = [[0.0; MAX_CONTACTS]; MAX_CONTACTS];
+        for (a, &j) in set.iter().enumerate() {
+            lambda[a] = self.minv_t[j].iter().zip(acc).map(|(x, y)| x * y).sum();
+            for (b, &l) in set.iter().enumerate() {
+                let c = &self.contacts[l];
+                g[a][b] = self.gram[j][l];
+                if c.alpha != 0.0 {
+                    g[a][b] -= c.alpha * c.slope.dot(q) * self.tn[j][l];
+                }
+            }
+        }
+        solve_small(&mut g, lambda, k)
+    }
+
+    /// Add the sticking contacts' forces `−λ_k w_k` to `acc`.
+    #[inline]
+    fn apply_multipliers(&self, set: &[usize], q: &[f64], lambda: &[f64], acc: &mut [f64]) {
+        for (a, &j) in set.iter().enumerate() {
+            let c = &self.contacts[j];
+            c.tangent.add_scaled(acc, -lambda[a]);
+            if c.alpha != 0.0 {
+                if let Normal::Elastic { normal, .. } = &c.normal {
+                    normal.add_scaled(acc, c.alpha * lambda[a] * c.slope.dot(q));
+                }
+            }
+        }
+    }
+
+    /// The full generalised force (multipliers included) into `acc`, and the
+    /// multipliers of the sticking contacts (indexed by contact).
+    #[inline]
+    fn force(
+        &self,
+        t: f64,
+        modes: &Modes,
+        q: &[f64],
+        u: &[f64],
+        acc: &mut [f64],
+    ) -> [f64; MAX_CONTACTS] {
+        self.base_force(t, modes, q, u, acc, true);
+        let (set, k) = stick_set(modes);
+        let mut out = [0.0; MAX_CONTACTS];
+        if k > 0 {
+            let mut lambda = [0.0; MAX_CONTACTS];
+            // Regular by construction (checked in `refresh`); a singular
+            // solve leaves λ = NaN, which the integrator reports.
+            if !self.multipliers(&set[..k], q, acc, &mut lambda) {
+                lambda = [f64::NAN; MAX_CONTACTS];
+            }
+            self.apply_multipliers(&set[..k], q, &lambda, acc);
+            for a in 0..k {
+                out[set[a]] = lambda[a];
+            }
+        }
+        out
+    }
+
+    /// The stick-break guard value `sign·λ_i − μ_s F_n,i` of contact `i`
+    /// (slip friction of the other contacts included if `slip_friction`).
+    fn stick_guard(
+        &self,
+        t: f64,
+        modes: &Modes,
+        i: usize,
+        sign: f64,
+        z: &[f64],
+        slip_friction: bool,
+    ) -> f64 {
+        let n = self.dofs.len();
+        let (q, u) = z.split_at(n);
+        let mut stack = [0.0; STACK_DOFS];
+        let mut heap;
+        let acc: &mut [f64] = if n <= STACK_DOFS {
+            &mut stack[..n]
+        } else {
+            heap = vec![0.0; n];
+            &mut heap
+        };
+        self.base_force(t, modes, q, u, acc, slip_friction);
+        let (set, k) = stick_set(modes);
+        let mut lambda = [0.0; MAX_CONTACTS];
+        if !self.multipliers(&set[..k], q, acc, &mut lambda) {
+            return f64::NAN;
+        }
+        let a = set[..k].iter().position(|&j| j == i).unwrap_or(0);
+        let c = &self.contacts[i];
+        sign * lambda[a] - c.friction.mu_static() * c.normal_force(q, u)
+    }
+
+    /// Whether the stick guards of `modes` are affine in the state.
+    fn stick_guards_affine(&self, modes: &Modes) -> bool {
+        !self.has_ramp
+            && self.contacts.iter().enumerate().all(|(j, c)| {
+                let m = modes.get(j);
+                !(m == Mode::SlipPos || m == Mode::SlipNeg)
+                    || (c.friction.is_constant()
+                        && !matches!(
+                            c.normal,
+                            Normal::Elastic {
+                                bilateral: true,
+                                ..
+                            }
+                        ))
+            })
+    }
+
+    /// Mode of contact `i` at `(t, z)` given the others' `modes`: free if a
+    /// unilateral layer is open, else by the sign of v, and at `v = 0` stick
+    /// if its multiplier (with it sticking) is within `μ_s F_n`.
+    fn contact_mode(&self, t: f64, modes: &Modes, i: usize, z: &[f64]) -> Mode {
+        let n = self.dofs.len();
+        let (q, u) = z.split_at(n);
+        let c = &self.contacts[i];
+        let f_n = c.normal_force(q, u);
+        if c.can_open() {
+            if let Normal::Elastic { normal, .. } = &c.normal {
+                if normal.dot(q) < 0.0 || f_n < 0.0 {
+                    return Mode::Free;
+                }
+            }
+        }
+        let v = c.sliding_velocity(u);
+        if v != 0.0 {
+            return c.mode_for(v, 0.0, f_n);
+        }
+        let mut trial = *modes;
+        trial.set(i, Mode::Stick);
+        let lambda = self.stick_force(t, &trial, i, z);
+        c.mode_for(0.0, lambda, f_n)
+    }
+
+    /// Multiplier of sticking contact `i` in `modes`.
+    fn stick_force(&self, t: f64, modes: &Modes, i: usize, z: &[f64]) -> f64 {
+        // λ_i − μ_s F_n + μ_s F_n, without a second copy of the solve.
+        let c = &self.contacts[i];
+        let n = self.dofs.len();
+        self.stick_guard(t, modes, i, 1.0, z, true)
+            + c.friction.mu_static() * c.normal_force(&z[..n], &z[n..])
+    }
+
+    /// The sliding direction of contact `i` at steady sliding (`sign V`).
+    fn steady_mode(&self, i: usize) -> Mode {
+        if self.contacts[i].v >= 0.0 {
+            Mode::SlipPos
+        } else {
+            Mode::SlipNeg
+        }
+    }
+
+    /// The modes of steady sliding.
+    pub fn steady_modes(&self) -> Modes {
+        let mut m = Modes::all(self.contacts.len(), Mode::SlipPos);
+        for i in 0..self.contacts.len() {
+            m.set(i, self.steady_mode(i));
+        }
+        m
+    }
+
+    /// Right-hand side for any size (allocating; stability and tests).
+    pub fn field_dyn(&self, t: f64, modes: &Modes, z: &[f64]) -> Vec<f64> {
+        let n = self.dofs.len();
+        let (q, u) = z.split_at(n);
+        let mut acc = vec![0.0; n];
+        self.force(t, modes, q, u, &mut acc);
+        let mut dz = vec![0.0; 2 * n];
+        dz[..n].copy_from_slice(u);
+        self.apply_inv_mass(&acc, &mut dz[n..]);
+        dz
+    }
+
+    /// `∂(generalised force)/∂z` in the sliding modes at `z` (n × 2n): the
+    /// analytic Jacobian of the force (see the module docs).
+    fn force_jacobian(&self, modes: &Modes, z: &[f64]) -> DMatrix<f64> {
+        let n = self.dofs.len();
+        let (q, u) = z.split_at(n);
+        let mut j = DMatrix::<f64>::zeros(n, 2 * n);
+        for s in &self.springs {
+            for (a, ca) in s.on.idx.iter().zip(&s.on.coef) {
+                for (b, cb) in s.on.idx.iter().zip(&s.on.coef) {
+                    j[(*a, *b)] -= s.k * ca * cb;
+                    j[(*a, n + *b)] -= s.c * ca * cb;
+                }
+            }
+        }
+        if let Some(k) = &self.k_matrix {
+            for (r, c, v) in k.entries() {
+                j[(r, c)] -= v;
+            }
+        }
+        if let Some(cm) = &self.c_matrix {
+            for (r, c, v) in cm.entries() {
+                j[(r, n + c)] -= v;
+            }
+        }
+        for (i, c) in self.contacts.iter().enumerate() {
+            let mode = modes.get(i);
+            if mode == Mode::Free {
+                continue;
+            }
+            let f_n = c.normal_force(q, u);
+            // ∇F_n (dense, 2n).
+            let mut g_n = vec![0.0; 2 * n];
+            if let Normal::Elastic {
+                normal, k, c: cc, ..
+            } = &c.normal
+            {
+                for (a, ca) in normal.idx.iter().zip(&normal.coef) {
+                    g_n[*a] += k * ca;
+                    g_n[n + *a] += cc * ca;
+                }
+                // −F_n·n
+                for (a, ca) in normal.idx.iter().zip(&normal.coef) {
+                    for (col, g) in g_n.iter().enumerate() {
+                        j[(*a, col)] -= ca * g;
+                    }
+                }
+            }
+            let v = c.sliding_velocity(u);
+            let s = mode.slip_sign();
+            let (fnf, g_nf) = if matches!(
+                c.normal,
+                Normal::Elastic {
+                    bilateral: true,
+                    ..
+                }
+            ) && f_n < 0.0
+            {
+                (0.0, vec![0.0; 2 * n])
+            } else {
+                (f_n, g_n.clone())
+            };
+            let mu = c.friction.mu(s * v);
+            let dmu = c.friction.dmu(s * v);
+            let f_t = s * mu * fnf;
+            // ∇F_t = s μ ∇F_n + F_n μ'(s v) ∇v.
+            let mut g_t = vec![0.0; 2 * n];
+            for (col, g) in g_nf.iter().enumerate() {
+                g_t[col] = s * mu * g;
+            }
+            for (a, ca) in c.tangent.idx.iter().zip(&c.tangent.coef) {
+                g_t[n + *a] += fnf * dmu * ca;
+            }
+            for (a, ca) in c.tangent.idx.iter().zip(&c.tangent.coef) {
+                for (col, g) in g_t.iter().enumerate() {
+                    j[(*a, col)] -= ca * g;
+                }
+            }
+            if c.alpha != 0.0 {
+                if let Normal::Elastic { normal, .. } = &c.normal {
+                    // ∇F_f = α((s·q) ∇F_t + F_t s).
+                    let sq = c.slope.dot(q);
+                    let mut g_f: Vec<f64> = g_t.iter().map(|g| c.alpha * sq * g).collect();
+                    for (a, ca) in c.slope.idx.iter().zip(&c.slope.coef) {
+                        g_f[*a] += c.alpha * f_t * ca;
+                    }
+                    for (a, ca) in normal.idx.iter().zip(&normal.coef) {
+                        for (col, g) in g_f.iter().enumerate() {
+                            j[(*a, col)] += ca * g;
+                        }
+                    }
+                }
+            }
+        }
+        j
+    }
+
+    /// The state matrix `∂f/∂z` (2n × 2n) of the sliding equations at `z`.
+    pub fn jacobian_dyn(&self, z: &[f64]) -> DMatrix<f64> {
+        let n = self.dofs.len();
+        let modes = self.sliding_modes_at(z);
+        let jf = self.force_jacobian(&modes, z);
+        let mut a = DMatrix::<f64>::zeros(2 * n, 2 * n);
+        for i in 0..n {
+            a[(i, n + i)] = 1.0;
+        }
+        let mut col = vec![0.0; n];
+        let mut out = vec![0.0; n];
+        for c in 0..2 * n {
+            for r in 0..n {
+                col[r] = jf[(r, c)];
+            }
+            self.apply_inv_mass(&col, &mut out);
+            for r in 0..n {
+                a[(n + r, c)] = out[r];
+            }
+        }
+        a
+    }
+
+    /// Slip modes by the sign of each contact's v at `z` (free where a unilateral layer is open).
+    fn sliding_modes_at(&self, z: &[f64]) -> Modes {
+        let n = self.dofs.len();
+        let mut m = self.steady_modes();
+        for (i, c) in self.contacts.iter().enumerate() {
+            let v = c.sliding_velocity(&z[n..]);
+            if v > 0.0 {
+                m.set(i, Mode::SlipPos);
+            } else if v < 0.0 {
+                m.set(i, Mode::SlipNeg);
+            }
+            if c.can_open() && c.normal_force(&z[..n], &z[n..]) <= 0.0 {
+                m.set(i, Mode::Free);
+            }
+        }
+        m
+    }
+
+    /// Steady sliding by Newton's method on the positions (velocities zero,
+    /// every contact sliding in the direction of its V): the generalised
+    /// force vanishes. Converges when the update is below 1e-14 of the
+    /// positions' size.
+    pub fn equilibrium_dyn(&self) -> Result<Vec<f64>, ModelError> {
+        let n = self.dofs.len();
+        if let Some(c) = self.contacts.iter().find(|c| c.v == 0.0) {
+            return Err(ModelError::NoSteadySliding(format!(
+                "contact '{}': V = 0 (the surface must move)",
+                c.name
+            )));
+        }
+        let modes = self.steady_modes();
+        let mut z = vec![0.0; 2 * n];
+        let mut acc = vec![0.0; n];
+        for _ in 0..100 {
+            let (q, u) = z.split_at(n);
+            self.force(f64::INFINITY, &modes, q, u, &mut acc);
+            let jf = self.force_jacobian(&modes, &z);
+            let a = jf.columns(0, n).into_owned();
+            let b = nalgebra::DVector::from_iterator(n, acc.iter().map(|x| -x));
+            let dq = a.lu().solve(&b).ok_or_else(|| {
+                ModelError::NoSteadySliding("the steady-sliding equations are singular (is every dof held by a spring or a contact?)".into())
+            })?;
+            let size = z[..n].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let step = dq.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            for r in 0..n {
+                z[r] += dq[r];
+            }
+            if !step.is_finite() {
+                break;
+            }
+            if step <= 1e-14 * size.max(f64::MIN_POSITIVE) || step == 0.0 {
+                for (i, c) in self.contacts.iter().enumerate() {
+                    let f_n = c.normal_force(&z[..n], &z[n..]);
+                    if c.can_open() && f_n <= 0.0 {
+                        return Err(ModelError::NoSteadySliding(format!(
+                            "contact '{}': the normal force at steady sliding, {f_n:.3e} N, is not positive",
+                            self.contacts[i].name
+                        )));
+                    }
+                }
+                return Ok(z);
+            }
+        }
+        Err(ModelError::NoSteadySliding(
+            "Newton's method did not converge on the steady-sliding state".into(),
+        ))
+    }
+
+    /// Forces and sliding velocity of contact `i` (any size).
+    pub fn observe_dyn(&self, t: f64, modes: &Modes, z: &[f64], i: usize) -> Observables {
+        let n = self.dofs.len();
+        let (q, u) = z.split_at(n);
+        let c = &self.contacts[i];
+        let v_rel = c.sliding_velocity(u);
+        let mode = modes.get(i);
+        let (normal_force, friction_force) = match mode {
+            Mode::Free => (0.0, 0.0),
+            Mode::Stick => (c.normal_force(q, u), self.stick_force(t, modes, i, z)),
+            _ => {
+                let f_n = c.normal_force(q, u);
+                (f_n, c.slip_force(mode, v_rel, f_n))
+            }
+        };
+        Observables {
+            normal_force,
+            friction_force,
+            v_rel,
+        }
+    }
+
+    // ---- Parameters: `<element>.<key>` and `mass.<dof>` ----
+
+    /// Every parameter key with its current value, in file order.
+    pub fn keys(&self) -> Vec<(String, f64)> {
+        let mut out = Vec::new();
+        for (d, m) in self.dofs.iter().zip(&self.masses) {
+            if *m > 0.0 {
+                out.push((format!("mass.{d}"), *m));
+            }
+        }
+        for s in &self.springs {
+            out.push((format!("{}.k", s.name), s.k));
+            out.push((format!("{}.c", s.name), s.c));
+        }
+        for f in &self.forces {
+            out.push((format!("{}.value", f.name), f.value));
+            out.push((format!("{}.ramp", f.name), f.ramp));
+        }
+        for c in &self.contacts {
+            match &c.normal {
+                Normal::Elastic { k, c: cc, .. } => {
+                    out.push((format!("{}.k", c.name), *k));
+                    out.push((format!("{}.c", c.name), *cc));
+                }
+                Normal::Prescribed(f) => out.push((format!("{}.normal_force", c.name), *f)),
+            }
+            out.push((format!("{}.V", c.name), c.v));
+            out.push((format!("{}.alpha", c.name), c.alpha));
+            for spec in c.friction.params() {
+                out.push((
+                    format!("{}.{}", c.name, spec.name),
+                    c.friction.get(spec.name).unwrap_or(f64::NAN),
+                ));
+            }
+        }
+        out
+    }
+
+    /// Value of a parameter by key.
+    pub fn get(&self, key: &str) -> Option<f64> {
+        self.keys()
+            .into_iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v)
+    }
+
+    /// Set a parameter by key, checking its range; the model is re-checked
+    /// (stick constraints, mass matrix) afterwards. Keys are
+    /// `<element>.<key>` and `mass.<dof>`.
+    pub fn set(&mut self, key: &str, value: f64) -> Result<(), ParamError> {
+        let invalid = |why: &str| ParamError::Invalid {
+            key: key.into(),
+            value,
+            why: why.into(),
+        };
+        let unknown = || ParamError::Unknown { key: key.into() };
+        let (el, k) = key.split_once('.').ok_or_else(unknown)?;
+        let nonneg = |v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(v)
+            } else {
+                Err(invalid("must be a finite number ≥ 0"))
+            }
+        };
+        let finite = |v: f64| {
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(invalid("must be a finite number"))
+            }
+        };
+        let mut refresh = false;
+        if el == "mass" {
+            let i = self.dofs.iter().position(|d| d == k).ok_or_else(unknown)?;
+            if !(value.is_finite() && value > 0.0) {
+                return Err(invalid("a mass must be a finite number > 0 (kg)"));
+            }
+            self.masses[i] = value;
+            refresh = true;
+        } else if let Some(s) = self.springs.iter_mut().find(|s| s.name == el) {
+            match k {
+                "k" => s.k = nonneg(value)?,
+                "c" => s.c = nonneg(value)?,
+                _ => return Err(unknown()),
+            }
+        } else if let Some(f) = self.forces.iter_mut().find(|f| f.name == el) {
+            match k {
+                "value" => f.value = finite(value)?,
+                "ramp" => f.ramp = nonneg(value)?,
+                _ => return Err(unknown()),
+            }
+            self.has_ramp = self.forces.iter().any(|f| f.ramp > 0.0);
+        } else if let Some(c) = self.contacts.iter_mut().find(|c| c.name == el) {
+            match (k, &mut c.normal) {
+                ("k", Normal::Elastic { k, .. }) => *k = nonneg(value)?,
+                ("c", Normal::Elastic { c, .. }) => *c = nonneg(value)?,
+                ("normal_force", Normal::Prescribed(f)) => *f = nonneg(value)?,
+                ("V", _) => c.v = finite(value)?,
+                ("alpha", _) => {
+                    c.alpha = finite(value)?;
+                    refresh = true;
+                }
+                (fk, _) if c.friction.get(fk).is_some() => {
+                    c.friction.set(fk, value).map_err(|e| prefixed(el, e))?;
+                }
+                _ => return Err(unknown()),
+            }
+        } else {
+            return Err(unknown());
+        }
+        if refresh {
+            self.refresh().map_err(|e| ParamError::Relation {
+                key: key.into(),
+                value,
+                why: e.0,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Check relations between parameters (each contact's friction law).
+    pub fn validate(&self) -> Result<(), ParamError> {
+        for c in &self.contacts {
+            c.friction.validate().map_err(|e| prefixed(&c.name, e))?;
+        }
+        Ok(())
+    }
+
+    /// Unit and meaning of a parameter key (for tables and axis labels).
+    pub fn describe(&self, key: &str) -> Option<(&'static str, String)> {
+        let (el, k) = key.split_once('.')?;
+        if el == "mass" {
+            return Some(("kg", format!("mass of dof {k}")));
+        }
+        if self.springs.iter().any(|s| s.name == el) {
+            return match k {
+                "k" => Some(("N/m", format!("stiffness of spring {el}"))),
+                "c" => Some(("kg/s", format!("damping of spring {el}"))),
+                _ => None,
+            };
+        }
+        if self.forces.iter().any(|f| f.name == el) {
+            return match k {
+                "value" => Some(("N", format!("value of force {el}"))),
+                "ramp" => Some(("s", format!("ramp time of force {el}"))),
+                _ => None,
+            };
+        }
+        let c = self.contacts.iter().find(|c| c.name == el)?;
+        match k {
+            "k" => Some(("N/m", format!("contact stiffness of {el}"))),
+            "c" => Some(("kg/s", format!("contact damping of {el}"))),
+            "normal_force" => Some(("N", format!("prescribed normal load of {el}"))),
+            "V" => Some(("m/s", format!("surface speed at {el}"))),
+            "alpha" => Some(("1/m", format!("follower-force coefficient of {el}"))),
+            _ => c
+                .friction
+                .params()
+                .iter()
+                .find(|p| p.name == k)
+                .map(|p| (p.unit, format!("{} ({el})", p.doc))),
+        }
+    }
+
+    /// The kind of values a key takes (sign), for lever and map ranges.
+    pub fn kind_of(&self, key: &str) -> crate::params::ParamKind {
+        use crate::params::ParamKind;
+        let (el, k) = key.split_once('.').unwrap_or(("", key));
+        if el == "mass" {
+            return ParamKind::Positive;
+        }
+        match k {
+            "value" | "V" | "alpha" => ParamKind::Any,
+            "k" | "c" | "ramp" | "normal_force" => ParamKind::NonNegative,
+            _ => self
+                .contacts
+                .iter()
+                .find(|c| c.name == el)
+                .and_then(|c| c.friction.params().iter().find(|p| p.name == k))
+                .map_or(ParamKind::Any, |p| p.kind),
+        }
+    }
+}
+
+/// A friction-law error with the key as users type it for a lumped model (`pad1.mu_k`).
+fn prefixed(el: &str, e: ParamError) -> ParamError {
+    match e {
+        ParamError::Unknown { key } => ParamError::Unknown {
+            key: format!("{el}.{key}"),
+        },
+        ParamError::Invalid { key, value, why } => ParamError::Invalid {
+            key: format!("{el}.{key}"),
+            value,
+            why,
+        },
+        ParamError::Relation { key, value, why } => ParamError::Relation {
+            key: format!("{el}.{key}"),
+            value,
+            why: why.replace("mu_k", &format!("{el}.mu_k")),
+        },
+        other => other,
+    }
+}
+
+impl<const N: usize> System<N> for Lumped {
+    fn system_name(&self) -> &str {
+        "lumped"
+    }
+    fn names(&self) -> Vec<String> {
+        self.states.clone()
+    }
+    fn contacts(&self) -> usize {
+        self.contacts.len()
+    }
+    fn contact_name(&self, i: usize) -> &str {
+        &self.contacts[i].name
+    }
+
+    #[inline]
+    fn field(&self, t: f64, modes: &Modes, z: &[f64; N], dz: &mut [f64; N]) {
+        let n = N / 2;
+        let (q, u) = z.split_at(n);
+        let mut acc = [0.0; N];
+        self.force(t, modes, q, u, &mut acc[..n]);
+        dz[..n].copy_from_slice(u);
+        self.apply_inv_mass(&acc[..n], &mut dz[n..]);
+    }
+
+    fn mode_guards(&self, modes: &Modes, out: &mut Guards<N>) {
+        out.clear();
+        let n = N / 2;
+        let affine_stick = self.stick_guards_affine(modes);
+        for (i, c) in self.contacts.iter().enumerate() {
+            let ci = i as u8;
+            let mode = modes.get(i);
+            let mut push = |kind: GuardKind, cvec: [f64; N], d: f64, affine: bool| {
+                out.push_guard(Guard {
+                    kind,
+                    c: cvec,
+                    d,
+                    contact: ci,
+                    affine,
+                })
+            };
+            if mode == Mode::Free {
+                if let Normal::Elastic { normal, .. } = &c.normal {
+                    let mut g = [0.0; N];
+                    normal.add_scaled(&mut g[..n], 1.0);
+                    push(GuardKind::Contact, g, 0.0, true);
+                }
+                continue;
+            }
+            if c.can_open() {
+                if let Normal::Elastic {
+                    normal, k, c: cc, ..
+                } = &c.normal
+                {
+                    let mut g = [0.0; N];
+                    normal.add_scaled(&mut g[..n], -k);
+                    normal.add_scaled(&mut g[n..], -cc);
+                    push(GuardKind::Separation, g, 0.0, true);
+                }
+            }
+            match mode {
+                Mode::SlipPos | Mode::SlipNeg => {
+                    let s = mode.slip_sign();
+                    let mut g = [0.0; N];
+                    c.tangent.add_scaled(&mut g[n..], -s);
+                    push(GuardKind::SlipZero, g, -s * c.v, true);
+                }
+                Mode::Stick => {
+                    for (kind, sign) in [
+                        (GuardKind::StickBreakPos, 1.0),
+                        (GuardKind::StickBreakNeg, -1.0),
+                    ] {
+                        // The (linear part's) gradient by unit evaluations: exact for an affine function.
+                        let t = f64::INFINITY;
+                        let zero = [0.0; N];
+                        let d = self.stick_guard(t, modes, i, sign, &zero, affine_stick);
+                        let mut g = [0.0; N];
+                        for (k, gk) in g.iter_mut().enumerate() {
+                            let mut e = [0.0; N];
+                            e[k] = 1.0;
+                            *gk = self.stick_guard(t, modes, i, sign, &e, affine_stick) - d;
+                        }
+                        push(kind, g, d, affine_stick);
+                    }
+                }
+                Mode::Free => unreachable!("handled above"),
+            }
+        }
+    }
+
+    fn guard_value(&self, t: f64, modes: &Modes, g: &Guard<N>, z: &[f64; N]) -> f64 {
+        if g.affine {
+            return g.eval(z);
+        }
+        let sign = if g.kind == GuardKind::StickBreakPos {
+            1.0
+        } else {
+            -1.0
+        };
+        self.stick_guard(t, modes, g.contact as usize, sign, z, true)
+    }
+
+    fn guard_gradient(&self, _t: f64, modes: &Modes, g: &Guard<N>, z: &[f64; N]) -> [f64; N] {
+        if g.affine {
+            return g.c;
+        }
+        // The linear part (g.c) plus −a_ij ∇(s_j μ(s_j v_j) F_n,j) of each slipping contact j.
+        let n = N / 2;
+        let i = g.contact as usize;
+        let sign = if g.kind == GuardKind::StickBreakPos {
+            1.0
+        } else {
+            -1.0
+        };
+        let a = self.slip_coupling(modes, i);
+        let mut out = g.c;
+        let (q, u) = z.split_at(n);
+        for (j, c) in self.contacts.iter().enumerate() {
+            let mode = modes.get(j);
+            if !(mode == Mode::SlipPos || mode == Mode::SlipNeg) || a[j] == 0.0 {
+                continue;
+            }
+            let s = mode.slip_sign();
+            let v = c.sliding_velocity(u);
+            let f_n = c.normal_force(q, u);
+            let fnf = c.friction_normal(f_n);
+            let clipped = fnf != f_n;
+            let (mu, dmu) = (c.friction.mu(s * v), c.friction.dmu(s * v));
+            let w = -sign * a[j];
+            // ∇(s μ(s v) F) = s μ ∇F + F μ' ∇v.
+            if let (
+                Normal::Elastic {
+                    normal, k, c: cc, ..
+                },
+                false,
+            ) = (&c.normal, clipped)
+            {
+                normal.add_scaled(&mut out[..n], w * s * mu * k);
+                normal.add_scaled(&mut out[n..], w * s * mu * cc);
+            }
+            c.tangent.add_scaled(&mut out[n..], w * fnf * dmu);
+        }
+        out
+    }
+
+    fn guard_slope_bound(
+        &self,
+        t0: f64,
+        h: f64,
+        modes: &Modes,
+        g: &Guard<N>,
+        lo: &[f64; N],
+        hi: &[f64; N],
+        rate: &[f64; N],
+    ) -> f64 {
+        let n = N / 2;
+        let mut l: f64 = (0..N).map(|k| g.c[k].abs() * rate[k]).sum();
+        if g.affine {
+            return l;
+        }
+        let i = g.contact as usize;
+        let a = self.slip_coupling(modes, i);
+        for (j, c) in self.contacts.iter().enumerate() {
+            let mode = modes.get(j);
+            if !(mode == Mode::SlipPos || mode == Mode::SlipNeg) || a[j] == 0.0 {
+                continue;
+            }
+            let s = mode.slip_sign();
+            let (vlo, vhi) = c.tangent.range(lo, hi, n);
+            let (vlo, vhi) = (s * (c.v + vlo), s * (c.v + vhi));
+            let (mu_max, dmu_max) = c.friction.bounds(vlo.min(vhi), vlo.max(vhi));
+            let (f_max, f_rate) = match &c.normal {
+                Normal::Elastic {
+                    normal, k, c: cc, ..
+                } => (
+                    k * normal.abs_bound(lo, hi, 0) + cc * normal.abs_bound(lo, hi, n),
+                    k * normal.abs_weighted(rate, 0) + cc * normal.abs_weighted(rate, n),
+                ),
+                Normal::Prescribed(f) => (f.abs(), 0.0),
+            };
+            let v_rate = c.tangent.abs_weighted(rate, n);
+            l += a[j].abs() * (dmu_max * v_rate * f_max + mu_max * f_rate);
+        }
+        if self.has_ramp {
+            // ∂g/∂t from the ramped forces: |P_i·on| value/ramp while ramping.
+            let p = self.stick_projection(modes, i);
+            for f in &self.forces {
+                if f.ramp > 0.0 && t0 < f.ramp {
+                    let pf: f64 =
+                        f.on.idx
+                            .iter()
+                            .zip(&f.on.coef)
+                            .map(|(k, c)| c * p[*k])
+                            .sum();
+                    l += h * pf.abs() * f.value.abs() / f.ramp;
+                }
+            }
+        }
+        l
+    }
+
+    fn switch(
+        &self,
+        t: f64,
+        modes: &Modes,
+        g: &Guard<N>,
+        z: &mut [f64; N],
+    ) -> (Modes, Option<EventKind>) {
+        let n = N / 2;
+        let i = g.contact as usize;
+        let old = modes.get(i);
+        let mut next = *modes;
+        match g.kind {
+            GuardKind::SlipZero => {
+                // On the surface v = 0 exactly: the mass-weighted projection
+                // u ← u − v·M⁻¹t/(t·M⁻¹t).
+                let c = &self.contacts[i];
+                let v = c.sliding_velocity(&z[n..]);
+                let w = v / self.gram[i][i];
+                for k in 0..n {
+                    z[n + k] -= w * self.minv_t[i][k];
+                }
+                let m = self.contact_mode(t, &next, i, &z[..]);
+                // Reached v = 0 without leaving the contact: stick or slip on.
+                let m = if m == Mode::Free { old } else { m };
+                next.set(i, m);
+                (next, Contact::event(old, m))
+            }
+            GuardKind::StickBreakPos => {
+                next.set(i, Mode::SlipPos);
+                (next, Some(EventKind::Slip))
+            }
+            GuardKind::StickBreakNeg => {
+                next.set(i, Mode::SlipNeg);
+                (next, Some(EventKind::Slip))
+            }
+            GuardKind::Separation => {
+                next.set(i, Mode::Free);
+                (next, Some(EventKind::Separate))
+            }
+            GuardKind::Contact => {
+                // On the surface δ = 0: decide the friction mode as in contact.
+                let c = &self.contacts[i];
+                let f_n = c.normal_force(&z[..n], &z[n..]);
+                let v = c.sliding_velocity(&z[n..]);
+                let m = if v != 0.0 {
+                    c.mode_for(v, 0.0, f_n)
+                } else {
+                    let mut trial = next;
+                    trial.set(i, Mode::Stick);
+                    c.mode_for(0.0, self.stick_force(t, &trial, i, &z[..]), f_n)
+                };
+                next.set(i, m);
+                (next, Some(EventKind::Contact))
+            }
+        }
+    }
+
+    fn start_modes(&self, t: f64, z: &[f64; N]) -> Modes {
+        let mut m = Modes::all(self.contacts.len(), Mode::Free);
+        for i in 0..self.contacts.len() {
+            let mode = self.contact_mode(t, &m, i, &z[..]);
+            m.set(i, mode);
+        }
+        m
+    }
+
+    fn observe_contact(&self, t: f64, modes: &Modes, z: &[f64; N], i: usize) -> Observables {
+        self.observe_dyn(t, modes, z, i)
+    }
+
+    fn breakpoint_after(&self, t: f64) -> Option<f64> {
+        self.forces
+            .iter()
+            .filter(|f| f.ramp > 0.0 && t < f.ramp)
+            .map(|f| f.ramp)
+            .fold(None, |a: Option<f64>, b| Some(a.map_or(b, |a| a.min(b))))
+    }
+
+    fn steady_sliding(&self) -> Result<[f64; N], ModelError> {
+        let z = self.equilibrium_dyn()?;
+        let mut out = [0.0; N];
+        out.copy_from_slice(&z);
+        Ok(out)
+    }
+
+    fn state_jacobian(&self, z: &[f64; N]) -> [[f64; N]; N] {
+        let a = self.jacobian_dyn(z);
+        let mut out = [[0.0; N]; N];
+        for (r, row) in out.iter_mut().enumerate() {
+            for (c, x) in row.iter_mut().enumerate() {
+                *x = a[(r, c)];
+            }
+        }
+        out
+    }
+}
+
+impl Lumped {
+    /// Row `i` of `P = G_S⁻¹ T_S M⁻¹` for the stick set of `modes`, as a dense n-vector:
+    /// `λ_i = P_i·f`.
+    fn stick_projection(&self, modes: &Modes, i: usize) -> Vec<f64> {
+        let n = self.dofs.len();
+        let (set, k) = stick_set(modes);
+        let a = set[..k].iter().position(|&j| j == i).unwrap_or(0);
+        let mut p = vec![0.0; n];
+        // Row a of G⁻¹: solve Gᵀ x = e_a (G is symmetric without follower terms).
+        let mut g = [[0.0; MAX_CONTACTS]; MAX_CONTACTS];
+        for (r, &j) in set[..k].iter().enumerate() {
+            for (c, &l) in set[..k].iter().enumerate() {
+                g[r][c] = self.gram[l][j];
+            }
+        }
+        let mut x = [0.0; MAX_CONTACTS];
+        x[a] = 1.0;
+        if !solve_small(&mut g, &mut x, k) {
+            return vec![f64::INFINITY; n];
+        }
+        for (r, &j) in set[..k].iter().enumerate() {
+            for (pk, m) in p.iter_mut().zip(&self.minv_t[j]) {
+                *pk += x[r] * m;
+            }
+        }
+        p
+    }
+
+    /// `a_ij = P_i·t_j`: how contact j's friction force enters sticking contact i's multiplier.
+    fn slip_coupling(&self, modes: &Modes, i: usize) -> [f64; MAX_CONTACTS] {
+        let p = self.stick_projection(modes, i);
+        let mut a = [0.0; MAX_CONTACTS];
+        for (j, c) in self.contacts.iter().enumerate() {
+            a[j] = c.tangent.dot(&p);
+        }
+        a
+    }
+}
+
+/// Most dofs a lumped model may have to be simulated: the integrator works on
+/// fixed-size state arrays, so each size is compiled in (`2·MAX_SIM_DOFS`
+/// states at most). Stability analysis works for any size.
+pub const MAX_SIM_DOFS: usize = 16;
+
+/// A lumped model seen at one state count `N = 2·dofs`, so that generic code
+/// (`simulate`, `analyse`) infers `N` from the type. Delegates everything.
+#[derive(Debug, Clone, Copy)]
+pub struct Fixed<'a, const N: usize>(pub &'a Lumped);
+
+impl<const N: usize> System<N> for Fixed<'_, N> {
+    fn system_name(&self) -> &str {
+        "lumped"
+    }
+    fn names(&self) -> Vec<String> {
+        self.0.states.clone()
+    }
+    fn contacts(&self) -> usize {
+        self.0.contacts.len()
+    }
+    fn contact_name(&self, i: usize) -> &str {
+        &self.0.contacts[i].name
+    }
+    #[inline(always)]
+    fn field(&self, t: f64, modes: &Modes, z: &[f64; N], dz: &mut [f64; N]) {
+        <Lumped as System<N>>::field(self.0, t, modes, z, dz)
+    }
+    fn mode_guards(&self, modes: &Modes, out: &mut Guards<N>) {
+        <Lumped as System<N>>::mode_guards(self.0, modes, out)
+    }
+    #[inline]
+    fn guard_value(&self, t: f64, modes: &Modes, g: &Guard<N>, z: &[f64; N]) -> f64 {
+        <Lumped as System<N>>::guard_value(self.0, t, modes, g, z)
+    }
+    fn guard_gradient(&self, t: f64, modes: &Modes, g: &Guard<N>, z: &[f64; N]) -> [f64; N] {
+        <Lumped as System<N>>::guard_gradient(self.0, t, modes, g, z)
+    }
+    fn guard_slope_bound(
+        &self,
+        t0: f64,
+        h: f64,
+        modes: &Modes,
+        g: &Guard<N>,
+        lo: &[f64; N],
+        hi: &[f64; N],
+        rate: &[f64; N],
+    ) -> f64 {
+        <Lumped as System<N>>::guard_slope_bound(self.0, t0, h, modes, g, lo, hi, rate)
+    }
+    fn switch(
+        &self,
+        t: f64,
+        modes: &Modes,
+        g: &Guard<N>,
+        z: &mut [f64; N],
+    ) -> (Modes, Option<EventKind>) {
+        <Lumped as System<N>>::switch(self.0, t, modes, g, z)
+    }
+    fn start_modes(&self, t: f64, z: &[f64; N]) -> Modes {
+        <Lumped as System<N>>::start_modes(self.0, t, z)
+    }
+    fn observe_contact(&self, t: f64, modes: &Modes, z: &[f64; N], i: usize) -> Observables {
+        self.0.observe_dyn(t, modes, z, i)
+    }
+    fn breakpoint_after(&self, t: f64) -> Option<f64> {
+        <Lumped as System<N>>::breakpoint_after(self.0, t)
+    }
+    fn steady_sliding(&self) -> Result<[f64; N], ModelError> {
+        <Lumped as System<N>>::steady_sliding(self.0)
+    }
+    fn state_jacobian(&self, z: &[f64; N]) -> [[f64; N]; N] {
+        <Lumped as System<N>>::state_jacobian(self.0, z)
+    }
+}
+
+/// Run `$body` with `$m` bound to `&Fixed<N>` for the lumped model `$l`
+/// (`N = 2·dofs`, dofs ≤ [`MAX_SIM_DOFS`]), or evaluate `$fallback` for a
+/// larger model.
+#[macro_export]
+macro_rules! with_lumped_size {
+    ($l:expr, $m:ident => $body:expr, else => $fallback:expr) => {{
+        use $crate::model::lumped::Fixed;
+        let l: &$crate::Lumped = $l;
+        match l.dof_count() {
+            1 => {
+                let $m = &Fixed::<2>(l);
+                $body
+            }
+            2 => {
+                let $m = &Fixed::<4>(l);
+                $body
+            }
+            3 => {
+                let $m = &Fixed::<6>(l);
+                $body
+            }
+            4 => {
+                let $m = &Fixed::<8>(l);
+                $body
+            }
+            5 => {
+                let $m = &Fixed::<10>(l);
+                $body
+            }
+            6 => {
+                let $m = &Fixed::<12>(l);
+                $body
+            }
+            7 => {
+                let $m = &Fixed::<14>(l);
+                $body
+            }
+            8 => {
+                let $m = &Fixed::<16>(l);
+                $body
+            }
+            9 => {
+                let $m = &Fixed::<18>(l);
+                $body
+            }
+            10 => {
+                let $m = &Fixed::<20>(l);
+                $body
+            }
+            11 => {
+                let $m = &Fixed::<22>(l);
+                $body
+            }
+            12 => {
+                let $m = &Fixed::<24>(l);
+                $body
+            }
+            13 => {
+                let $m = &Fixed::<26>(l);
+                $body
+            }
+            14 => {
+                let $m = &Fixed::<28>(l);
+                $body
+            }
+            15 => {
+                let $m = &Fixed::<30>(l);
+                $body
+            }
+            16 => {
+                let $m = &Fixed::<32>(l);
+                $body
+            }
+            _ => $fallback,
+        }
+    }};
+}
+
+/// The thesis's disc–pad (a [`super::disc_pad::DiscPad`]'s parameters) as a
+/// lumped description, exactly as `scenarios/lumped/disc-pad.toml` writes it:
+/// springs `disc_x`, `disc_y`, `pad_x`, the force `brake` (−N on y_p, with
+/// its ramp) and the contact `pad` (normal {y_d: 1, y_p: −1}, tangent
+/// {x_d: 1, x_p: −1}, follower slope {y_d: 1}).
+pub fn disc_pad_spec(m: &super::disc_pad::DiscPad) -> LumpedSpec {
+    let p = &m.p;
+    let t = |v: &[(&str, f64)]| -> Terms { v.iter().map(|(n, c)| (n.to_string(), *c)).collect() };
+    let spring = |name: &str, dof: &str, k: f64, c: f64| SpringSpec {
+        name: name.into(),
+        on: t(&[(dof, 1.0)]),
+        k,
+        c,
+    };
+    LumpedSpec {
+        dofs: ["x_d", "x_p", "y_d", "y_p"].map(String::from).to_vec(),
+        masses: t(&[
+            ("x_d", p.m_d),
+            ("x_p", p.m_p),
+            ("y_d", p.m_d),
+            ("y_p", p.m_p),
+        ]),
+        springs: vec![
+            spring("disc_x", "x_d", p.k_dx, p.c_dx),
+            spring("disc_y", "y_d", p.k_dy, p.c_dy),
+            spring("pad_x", "x_p", p.k_px, p.c_px),
+        ],
+        forces: vec![ForceSpec {
+            name: "brake".into(),
+            on: t(&[("y_p", 1.0)]),
+            value: -p.N,
+            ramp: p.t_ramp,
+        }],
+        contacts: vec![ContactSpec {
+            name: "pad".into(),
+            normal: Some(t(&[("y_d", 1.0), ("y_p", -1.0)])),
+            k: Some(p.k_py),
+            c: Some(p.c_py),
+            bilateral: m.contact == super::disc_pad::Contact::Bilateral,
+            normal_force: None,
+            tangent: Some(t(&[("x_d", 1.0), ("x_p", -1.0)])),
+            v: p.V,
+            friction: m.friction,
+            alpha: p.alpha,
+            slope: t(&[("y_d", 1.0)]),
+        }],
+        ..Default::default()
+    }
+}
+
+/// The symmetric two-pad brake of `scenarios/lumped/two-pad-brake.toml`: a
+/// disc (x_d, y_d; twice the thesis's modal mass, stiffness and damping)
+/// between two thesis pads pressed from opposite sides.
+pub fn two_pad_spec() -> LumpedSpec {
+    let half = disc_pad_spec(&super::disc_pad::DiscPad::default());
+    let t = |v: &[(&str, f64)]| -> Terms { v.iter().map(|(n, c)| (n.to_string(), *c)).collect() };
+    let pad = &half.contacts[0];
+    let contact = |name: &str, normal: &[(&str, f64)], tangent: &[(&str, f64)]| ContactSpec {
+        name: name.into(),
+        normal: Some(t(normal)),
+        tangent: Some(t(tangent)),
+        slope: Vec::new(),
+        ..pad.clone()
+    };
+    let spring = |name: &str, dof: &str, k: f64, c: f64| SpringSpec {
+        name: name.into(),
+        on: t(&[(dof, 1.0)]),
+        k,
+        c,
+    };
+    let force = |name: &str, dof: &str, value: f64| ForceSpec {
+        name: name.into(),
+        on: t(&[(dof, 1.0)]),
+        value,
+        ramp: 0.0,
+    };
+    LumpedSpec {
+        dofs: ["x_d", "y_d", "x_p1", "y_p1", "x_p2", "y_p2"]
+            .map(String::from)
+            .to_vec(),
+        masses: t(&[
+            ("x_d", 2.0),
+            ("y_d", 2.0),
+            ("x_p1", 0.1),
+            ("y_p1", 0.1),
+            ("x_p2", 0.1),
+            ("y_p2", 0.1),
+        ]),
+        springs: vec![
+            spring("disc_x", "x_d", 2.0e9, 2.0),
+            spring("disc_y", "y_d", 1.6e7, 2.0),
+            spring("pad1_x", "x_p1", 1.7e9, 0.2),
+            spring("pad2_x", "x_p2", 1.7e9, 0.2),
+        ],
+        forces: vec![
+            force("brake_1", "y_p1", -500.0),
+            force("brake_2", "y_p2", 500.0),
+        ],
+        contacts: vec![
+            contact(
+                "pad1",
+                &[("y_d", 1.0), ("y_p1", -1.0)],
+                &[("x_d", 1.0), ("x_p1", -1.0)],
+            ),
+            contact(
+                "pad2",
+                &[("y_p2", 1.0), ("y_d", -1.0)],
+                &[("x_d", 1.0), ("x_p2", -1.0)],
+            ),
+        ],
+        ..Default::default()
+    }
+}

@@ -1,0 +1,381 @@
+//! `model = "lumped"` scenario files: the TOML tables (`dofs`, `[masses]`,
+//! `[[spring]]`, `[[force]]`, `[[contact]]`, `[matrices]`) → a validated
+//! [`Lumped`] model, and back to TOML. Every error names the element and key
+//! (`spring 'disc_x': on: unknown dof 'x_q'`). Matrix Market files named in
+//! `[matrices]` are read relative to the scenario file's folder.
+
+use crate::scenario::InputError;
+use squeal_core::model::contact::Normal;
+use squeal_core::model::lumped::{ContactSpec, ForceSpec, LumpedSpec, SpringSpec, Terms, Triplets};
+use squeal_core::{FrictionLaw, Lumped};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Where a lumped model's matrices came from (kept for `scenario show`).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MatrixFiles {
+    /// `M`, `K`, `C` paths as written in the file.
+    pub paths: Vec<(String, String)>,
+}
+
+/// The top-level keys a lumped scenario adds.
+pub const LUMPED_KEYS: [&str; 6] = ["dofs", "masses", "spring", "force", "contact", "matrices"];
+
+fn err<T>(msg: impl Into<String>) -> Result<T, InputError> {
+    Err(InputError(msg.into()))
+}
+
+fn number(what: &str, key: &str, v: &toml::Value) -> Result<f64, InputError> {
+    match v {
+        toml::Value::Float(x) => Ok(*x),
+        toml::Value::Integer(i) => Ok(*i as f64),
+        other => err(format!("{what}: {key} = {other}: expected a number")),
+    }
+}
+
+fn terms(what: &str, key: &str, v: &toml::Value) -> Result<Terms, InputError> {
+    let toml::Value::Table(t) = v else {
+        return err(format!(
+            "{what}: {key} = {v}: expected a table of dof = coefficient, e.g. {{ x_d = 1.0 }}"
+        ));
+    };
+    t.iter()
+        .map(|(d, c)| Ok((d.clone(), number(what, &format!("{key}.{d}"), c)?)))
+        .collect()
+}
+
+fn tables<'a>(table: &'a toml::Table, key: &str) -> Result<Vec<&'a toml::Table>, InputError> {
+    match table.get(key) {
+        None => Ok(Vec::new()),
+        Some(toml::Value::Array(a)) => a
+            .iter()
+            .map(|v| match v {
+                toml::Value::Table(t) => Ok(t),
+                other => err(format!("[[{key}]]: expected tables, got {other}")),
+            })
+            .collect(),
+        Some(other) => err(format!("{key} = {other}: expected [[{key}]] tables")),
+    }
+}
+
+fn element_name(kind: &str, i: usize, t: &toml::Table) -> Result<String, InputError> {
+    match t.get("name") {
+        Some(toml::Value::String(s)) => Ok(s.clone()),
+        Some(other) => err(format!(
+            "{kind} #{}: name = {other}: expected a string",
+            i + 1
+        )),
+        None => err(format!("{kind} #{}: name: missing", i + 1)),
+    }
+}
+
+fn check_keys(what: &str, t: &toml::Table, allowed: &[&str]) -> Result<(), InputError> {
+    for k in t.keys() {
+        if !allowed.contains(&k.as_str()) {
+            return err(format!(
+                "{what}: unknown key '{k}' (keys: {})",
+                allowed.join(", ")
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Read a lumped model from a scenario's top-level table. `base` is the
+/// folder matrix files are relative to (`None`: the current folder).
+pub fn parse(
+    table: &toml::Table,
+    base: Option<&Path>,
+) -> Result<(Lumped, MatrixFiles), InputError> {
+    let mut spec = LumpedSpec::default();
+    let mut files = MatrixFiles::default();
+    if let Some(m) = table.get("matrices") {
+        let toml::Value::Table(m) = m else {
+            return err(format!(
+                "matrices = {m}: expected a table [matrices] with M, K, C file names"
+            ));
+        };
+        check_keys("matrices", m, &["M", "K", "C"])?;
+        for (key, v) in m {
+            let toml::Value::String(p) = v else {
+                return err(format!(
+                    "matrices: {key} = {v}: expected a file name (Matrix Market, .mtx)"
+                ));
+            };
+            let path = base.map_or_else(|| PathBuf::from(p), |b| b.join(p));
+            let text = std::fs::read_to_string(&path).map_err(|e| {
+                InputError(format!(
+                    "matrices: {key} = '{p}': cannot read {}: {e}",
+                    path.display()
+                ))
+            })?;
+            let t: Triplets = squeal_core::matrix_market::parse(&text)
+                .map_err(|e| InputError(format!("matrices: {key} = '{p}': {e}")))?;
+            files.paths.push((key.clone(), p.clone()));
+            match key.as_str() {
+                "M" => spec.m = Some(t),
+                "K" => spec.k = Some(t),
+                _ => spec.c = Some(t),
+            }
+        }
+    }
+    spec.dofs = match table.get("dofs") {
+        Some(toml::Value::Array(a)) => a
+            .iter()
+            .map(|v| match v {
+                toml::Value::String(s) => Ok(s.clone()),
+                other => err(format!("dofs: {other}: expected dof names (strings)")),
+            })
+            .collect::<Result<_, _>>()?,
+        Some(other) => return err(format!("dofs = {other}: expected a list of names")),
+        None => {
+            // Numbered after the matrices: q1 … qn.
+            let n = [&spec.m, &spec.k, &spec.c]
+                .iter()
+                .find_map(|t| t.as_ref().map(|t| t.rows))
+                .ok_or_else(|| {
+                    InputError(
+                        "dofs: missing (a list of dof names, or [matrices] to number them)".into(),
+                    )
+                })?;
+            (1..=n).map(|i| format!("q{i}")).collect()
+        }
+    };
+    if let Some(m) = table.get("masses") {
+        let toml::Value::Table(m) = m else {
+            return err(format!(
+                "masses = {m}: expected a table [masses] of dof = mass"
+            ));
+        };
+        for (d, v) in m {
+            spec.masses.push((d.clone(), number("masses", d, v)?));
+        }
+    }
+    for (i, t) in tables(table, "spring")?.into_iter().enumerate() {
+        let name = element_name("spring", i, t)?;
+        let what = format!("spring '{name}'");
+        check_keys(&what, t, &["name", "on", "k", "c"])?;
+        let on = terms(
+            &what,
+            "on",
+            t.get("on")
+                .ok_or_else(|| InputError(format!("{what}: on: missing")))?,
+        )?;
+        let k = number(
+            &what,
+            "k",
+            t.get("k")
+                .ok_or_else(|| InputError(format!("{what}: k: missing")))?,
+        )?;
+        let c = t
+            .get("c")
+            .map(|v| number(&what, "c", v))
+            .transpose()?
+            .unwrap_or(0.0);
+        spec.springs.push(SpringSpec { name, on, k, c });
+    }
+    for (i, t) in tables(table, "force")?.into_iter().enumerate() {
+        let name = element_name("force", i, t)?;
+        let what = format!("force '{name}'");
+        check_keys(&what, t, &["name", "on", "value", "ramp"])?;
+        let on = terms(
+            &what,
+            "on",
+            t.get("on")
+                .ok_or_else(|| InputError(format!("{what}: on: missing")))?,
+        )?;
+        let value = number(
+            &what,
+            "value",
+            t.get("value")
+                .ok_or_else(|| InputError(format!("{what}: value: missing")))?,
+        )?;
+        let ramp = t
+            .get("ramp")
+            .map(|v| number(&what, "ramp", v))
+            .transpose()?
+            .unwrap_or(0.0);
+        spec.forces.push(ForceSpec {
+            name,
+            on,
+            value,
+            ramp,
+        });
+    }
+    for (i, t) in tables(table, "contact")?.into_iter().enumerate() {
+        let name = element_name("contact", i, t)?;
+        let what = format!("contact '{name}'");
+        let law_name = match t.get("friction") {
+            Some(toml::Value::String(s)) => s.clone(),
+            Some(other) => return err(format!("{what}: friction = {other}: expected a law name")),
+            None => "thesis".into(),
+        };
+        let mut friction =
+            FrictionLaw::by_name(&law_name).map_err(|e| InputError(format!("{what}: {e}")))?;
+        let mut allowed = vec![
+            "name",
+            "normal",
+            "k",
+            "c",
+            "contact",
+            "normal_force",
+            "tangent",
+            "V",
+            "friction",
+            "alpha",
+            "slope",
+        ];
+        allowed.extend(friction.params().iter().map(|p| p.name));
+        check_keys(&what, t, &allowed)?;
+        for p in friction.params() {
+            if let Some(v) = t.get(p.name) {
+                let x = number(&what, p.name, v)?;
+                friction
+                    .set(p.name, x)
+                    .map_err(|e| InputError(format!("{what}: {e}")))?;
+            }
+        }
+        let bilateral = match t.get("contact") {
+            None => false,
+            Some(toml::Value::String(s)) if s == "unilateral" => false,
+            Some(toml::Value::String(s)) if s == "bilateral" => true,
+            Some(other) => {
+                return err(format!(
+                    "{what}: contact = {other}: expected \"unilateral\" or \"bilateral\""
+                ))
+            }
+        };
+        let opt = |key: &str| t.get(key).map(|v| number(&what, key, v)).transpose();
+        spec.contacts.push(ContactSpec {
+            name,
+            normal: t
+                .get("normal")
+                .map(|v| terms(&what, "normal", v))
+                .transpose()?,
+            k: opt("k")?,
+            c: opt("c")?,
+            bilateral,
+            normal_force: opt("normal_force")?,
+            tangent: t
+                .get("tangent")
+                .map(|v| terms(&what, "tangent", v))
+                .transpose()?,
+            v: opt("V")?.unwrap_or(0.0),
+            friction,
+            alpha: opt("alpha")?.unwrap_or(0.0),
+            slope: t
+                .get("slope")
+                .map(|v| terms(&what, "slope", v))
+                .transpose()?
+                .unwrap_or_default(),
+        });
+    }
+    let model = Lumped::build(&spec).map_err(|e| InputError(e.0))?;
+    Ok((model, files))
+}
+
+fn combo(l: &Lumped, c: &squeal_core::model::contact::Combination) -> String {
+    let parts: Vec<String> = c
+        .idx
+        .iter()
+        .zip(&c.coef)
+        .map(|(i, v)| format!("{} = {v:?}", l.dofs()[*i]))
+        .collect();
+    format!("{{ {} }}", parts.join(", "))
+}
+
+/// The model's tables as TOML (current parameter values), for `scenario show`.
+pub fn to_toml(l: &Lumped, files: &MatrixFiles) -> String {
+    let mut t = String::new();
+    let dofs: Vec<String> = l.dofs().iter().map(|d| format!("{d:?}")).collect();
+    let _ = writeln!(t, "dofs = [{}]", dofs.join(", "));
+    if !files.paths.is_empty() {
+        let _ = writeln!(
+            t,
+            "\n[matrices]                        # Matrix Market files, relative to this file"
+        );
+        for (k, p) in &files.paths {
+            let _ = writeln!(t, "{k} = {p:?}");
+        }
+    }
+    let masses: Vec<(String, f64)> = l
+        .keys()
+        .into_iter()
+        .filter_map(|(k, v)| k.strip_prefix("mass.").map(|d| (d.to_string(), v)))
+        .collect();
+    if !masses.is_empty() {
+        let _ = writeln!(
+            t,
+            "\n[masses]                          # kg (kg·m² for a rotation)"
+        );
+        for (d, m) in masses {
+            let _ = writeln!(t, "{d} = {m:?}");
+        }
+    }
+    for s in &l.springs {
+        let _ = writeln!(
+            t,
+            "\n[[spring]]\nname = {:?}\non = {}\nk = {:?}\nc = {:?}",
+            s.name,
+            combo(l, &s.on),
+            s.k,
+            s.c
+        );
+    }
+    for f in &l.forces {
+        let _ = writeln!(
+            t,
+            "\n[[force]]\nname = {:?}\non = {}\nvalue = {:?}",
+            f.name,
+            combo(l, &f.on),
+            f.value
+        );
+        if f.ramp > 0.0 {
+            let _ = writeln!(t, "ramp = {:?}", f.ramp);
+        }
+    }
+    for c in &l.contacts {
+        let _ = writeln!(t, "\n[[contact]]\nname = {:?}", c.name);
+        match &c.normal {
+            Normal::Elastic {
+                normal,
+                k,
+                c: cc,
+                bilateral,
+            } => {
+                let _ = writeln!(
+                    t,
+                    "normal = {}\nk = {k:?}\nc = {cc:?}\ncontact = {:?}",
+                    combo(l, normal),
+                    if *bilateral {
+                        "bilateral"
+                    } else {
+                        "unilateral"
+                    }
+                );
+            }
+            Normal::Prescribed(f) => {
+                let _ = writeln!(t, "normal_force = {f:?}");
+            }
+        }
+        let _ = writeln!(
+            t,
+            "tangent = {}\nV = {:?}\nfriction = {:?}",
+            combo(l, &c.tangent),
+            c.v,
+            c.friction.name()
+        );
+        for p in c.friction.params() {
+            let _ = writeln!(
+                t,
+                "{} = {:?}",
+                p.name,
+                c.friction.get(p.name).unwrap_or(f64::NAN)
+            );
+        }
+        if c.alpha != 0.0 || !c.slope.is_empty() {
+            let _ = writeln!(t, "alpha = {:?}\nslope = {}", c.alpha, combo(l, &c.slope));
+        }
+    }
+    t
+}

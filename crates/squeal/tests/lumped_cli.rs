@@ -1,0 +1,375 @@
+//! Lumped scenario files end to end: the shipped files equal the built-ins,
+//! Matrix Market matrices read from files, every command on a lumped model,
+//! and bad files refused (exit 2) naming the element and key.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn squeal(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_squeal"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("squeal runs")
+}
+
+fn scenarios() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/lumped")
+}
+
+fn ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    serde_json::from_str(&ok(out)).unwrap()
+}
+
+#[test]
+fn shipped_lumped_files_equal_the_built_ins() {
+    let d = tempfile::tempdir().unwrap();
+    for (file, builtin) in [("disc-pad.toml", "disc-pad"), ("hoffmann.toml", "hoffmann")] {
+        let f = scenarios().join(file);
+        let a = json(&squeal(
+            d.path(),
+            &["stability", f.to_str().unwrap(), "--json"],
+        ));
+        let b = json(&squeal(d.path(), &["stability", builtin, "--json"]));
+        let (ea, eb) = (
+            a["eigenvalues"].as_array().unwrap(),
+            b["eigenvalues"].as_array().unwrap(),
+        );
+        assert_eq!(ea.len(), eb.len());
+        for (x, y) in ea.iter().zip(eb) {
+            let (xr, xi) = (x["re"].as_f64().unwrap(), x["im"].as_f64().unwrap());
+            let (yr, yi) = (y["re"].as_f64().unwrap(), y["im"].as_f64().unwrap());
+            let mag = yr.hypot(yi);
+            assert!(
+                (xr - yr).abs() <= 1e-10 * mag && (xi - yi).abs() <= 1e-10 * mag,
+                "{file}: {x} vs {y}"
+            );
+        }
+    }
+    // Hoffmann's critical friction coefficient (the contact's Coulomb mu_k; mu_s above it).
+    let f = scenarios().join("hoffmann.toml");
+    let a = json(&squeal(
+        d.path(),
+        &[
+            "critical",
+            f.to_str().unwrap(),
+            "--set",
+            "belt.mu_s=2",
+            "--param",
+            "belt.mu_k=0.01:1",
+            "--json",
+        ],
+    ));
+    let b = json(&squeal(
+        d.path(),
+        &["critical", "hoffmann", "--param", "mu=0.01:1", "--json"],
+    ));
+    let (x, y) = (a["value"].as_f64().unwrap(), b["value"].as_f64().unwrap());
+    assert!((x - y).abs() <= 1e-9 * y, "critical μ {x} vs {y}");
+    // The belt: the same events as the built-in belt-coulomb.
+    let f = scenarios().join("belt.toml");
+    ok(&squeal(
+        d.path(),
+        &["simulate", f.to_str().unwrap(), "--out", "lb"],
+    ));
+    ok(&squeal(
+        d.path(),
+        &["simulate", "belt-coulomb", "--out", "bb"],
+    ));
+    let ev = |dir: &str| -> Vec<(f64, String)> {
+        std::fs::read_to_string(d.path().join(dir).join("events.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let c: Vec<&str> = l.split(',').collect();
+                (c[0].parse().unwrap(), c[1].to_string())
+            })
+            .collect()
+    };
+    let (la, lb) = (ev("lb"), ev("bb"));
+    assert!(
+        la.len() >= 10 && la.len() == lb.len(),
+        "{} vs {}",
+        la.len(),
+        lb.len()
+    );
+    for (x, y) in la.iter().zip(&lb) {
+        assert_eq!(x.1, y.1);
+        assert!((x.0 - y.0).abs() <= 1e-8, "{x:?} vs {y:?}");
+    }
+}
+
+#[test]
+fn every_command_runs_on_a_lumped_model() {
+    let d = tempfile::tempdir().unwrap();
+    ok(&squeal(
+        d.path(),
+        &[
+            "simulate",
+            "two-pad-brake-asymmetric",
+            "--duration",
+            "0.005",
+            "--out",
+            "tp",
+        ],
+    ));
+    let dir = d.path().join("tp");
+    let series = std::fs::read_to_string(dir.join("series.csv")).unwrap();
+    let header = series.lines().next().unwrap();
+    assert_eq!(
+        header,
+        "t,x_d,y_d,x_p1,y_p1,x_p2,y_p2,vx_d,vy_d,vx_p1,vy_p1,vx_p2,vy_p2,\
+         pad1.F_n,pad1.F_t,pad1.v_rel,pad1.mode,pad2.F_n,pad2.F_t,pad2.v_rel,pad2.mode"
+    );
+    let events = std::fs::read_to_string(dir.join("events.csv")).unwrap();
+    assert_eq!(events.lines().next(), Some("t,kind,contact"));
+    assert!(
+        events
+            .lines()
+            .skip(1)
+            .all(|l| l.ends_with(",pad1") || l.ends_with(",pad2")),
+        "{events}"
+    );
+    let st = json(&squeal(
+        d.path(),
+        &["stability", "two-pad-brake", "--json", "--set", "pad2.V=2"],
+    ));
+    assert_eq!(st["eigenvalues"].as_array().unwrap().len(), 12);
+    let c = json(&squeal(
+        d.path(),
+        &[
+            "critical",
+            "two-pad-brake",
+            "--set",
+            "pad2.f1=0",
+            "--param",
+            "pad1.f1=0:0.06",
+            "--json",
+        ],
+    ));
+    assert!(c["value"].as_f64().is_some(), "{c}");
+    ok(&squeal(
+        d.path(),
+        &[
+            "map",
+            "two-pad-brake",
+            "--x",
+            "pad1.V=0.5:20:4",
+            "--y",
+            "brake_1.value=-3000:-100:3",
+            "--out",
+            "m",
+        ],
+    ));
+    let shown = ok(&squeal(d.path(), &["scenario", "show", "two-pad-brake"]));
+    assert!(
+        shown.contains("[[contact]]") && shown.contains("name = \"pad2\""),
+        "{shown}"
+    );
+}
+
+/// Hoffmann's model embedded in a larger system read from Matrix Market
+/// files: `M`, `K`, `C` hold the Hoffmann block (without the contact, which
+/// stays an element) and 298 decoupled, damped oscillators; the critical
+/// friction coefficient is the built-in model's.
+#[test]
+fn matrix_market_hoffmann_in_a_300_dof_system_has_the_same_critical_mu() {
+    let d = tempfile::tempdir().unwrap();
+    let n = 300;
+    let (k11, k12, k22, k3, c1, c2, n0) = (1.0e4, 2.0e3, 1.2e4, 1.0e4, 0.5, 0.5, 100.0);
+    let (mut m, mut k, mut c) = (String::new(), String::new(), String::new());
+    let mut mk = Vec::new();
+    let mut kk = vec![(1, 1, k11), (2, 1, k12), (2, 2, k22 - k3)];
+    let mut ck = vec![(1, 1, c1), (2, 2, c2)];
+    mk.push((1, 1, 1.0));
+    mk.push((2, 2, 1.0));
+    for i in 3..=n {
+        let f = i as f64;
+        mk.push((i, i, 0.5 + 0.01 * f));
+        kk.push((i, i, 1.0e4 * (1.0 + 0.1 * f)));
+        ck.push((i, i, 1.0 + 0.01 * f));
+    }
+    for (text, entries) in [(&mut m, &mk), (&mut k, &kk), (&mut c, &ck)] {
+        *text = format!(
+            "%%MatrixMarket matrix coordinate real symmetric\n% squeal test\n{n} {n} {}\n",
+            entries.len()
+        );
+        for (r, col, v) in entries.iter() {
+            text.push_str(&format!("{r} {col} {v:e}\n"));
+        }
+    }
+    std::fs::write(d.path().join("M.mtx"), m).unwrap();
+    std::fs::write(d.path().join("K.mtx"), k).unwrap();
+    std::fs::write(d.path().join("C.mtx"), c).unwrap();
+    let y0 = n0 / k3;
+    let toml = format!(
+        r#"name = "big"
+model = "lumped"
+
+[matrices]
+M = "M.mtx"
+K = "K.mtx"
+C = "C.mtx"
+
+[[force]]
+name = "fx"
+on = {{ q1 = 1.0 }}
+value = {}
+
+[[force]]
+name = "fy"
+on = {{ q2 = 1.0 }}
+value = {}
+
+[[contact]]
+name = "belt"
+normal = {{ q2 = 1.0 }}
+k = {k3}
+c = 0.0
+tangent = {{ q1 = -1.0 }}
+V = 1.0
+friction = "coulomb"
+mu_s = 2.0
+mu_k = 0.3
+"#,
+        k12 * y0,
+        k22 * y0
+    );
+    std::fs::write(d.path().join("big.toml"), toml).unwrap();
+    let a = json(&squeal(
+        d.path(),
+        &[
+            "critical",
+            "big.toml",
+            "--param",
+            "belt.mu_k=0.01:1",
+            "--grid",
+            "12",
+            "--json",
+        ],
+    ));
+    let b = json(&squeal(
+        d.path(),
+        &[
+            "critical",
+            "hoffmann",
+            "--param",
+            "mu=0.01:1",
+            "--grid",
+            "12",
+            "--json",
+        ],
+    ));
+    let (x, y) = (a["value"].as_f64().unwrap(), b["value"].as_f64().unwrap());
+    assert!((x - y).abs() <= 1e-9 * y, "critical μ {x} vs {y}");
+    // Simulation is refused for a model this size, with the limit stated.
+    let out = squeal(d.path(), &["simulate", "big.toml", "--out", "x"]);
+    assert_eq!(out.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("300 dofs") && e.contains("up to 16"), "{e}");
+}
+
+#[test]
+fn bad_lumped_files_exit_2_naming_element_and_key() {
+    let d = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(scenarios().join("disc-pad.toml")).unwrap();
+    std::fs::write(
+        d.path().join("A.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n3 4 1\n1 1 1.0\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.path().join("N.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n4 4 5\n1 1 1.0\n2 2 1.0\n3 3 1.0\n4 4 1.0\n1 2 0.5\n",
+    )
+    .unwrap();
+    let cases: Vec<(String, &str)> = vec![
+        (base.replace("on = { x_d = 1.0 }", "on = { x_q = 1.0 }"), "spring 'disc_x': on: unknown dof 'x_q'"),
+        (base.replace("x_p = 0.1\ny_d", "x_p = -0.1\ny_d"), "masses: x_p = -0.1"),
+        (base.replace("tangent = { x_d = 1.0, x_p = -1.0 }\n", ""), "contact 'pad': tangent: missing"),
+        (
+            base.replace("[solver]", "[matrices]\nM = \"A.mtx\"\n\n[solver]"),
+            "matrices: M is 3×4, not square",
+        ),
+        (
+            base.replace("[solver]", "[matrices]\nM = \"N.mtx\"\n\n[solver]"),
+            "matrices: M is not symmetric",
+        ),
+        (
+            base.replace("[solver]", "[[contact]]\nname = \"pad2\"\nnormal = { y_d = 1.0, y_p = -1.0 }\nk = 1e9\ntangent = { x_d = -2.0, x_p = 2.0 }\nV = 1.0\n\n[solver]"),
+            "contact 'pad2': tangent: its stick constraint is redundant with 'pad'",
+        ),
+        (base.replace("k = 4.25e9", "k = -4.25e9"), "contact 'pad': k = -4250000000: must be"),
+        (base.replace("f0 = 0.1", "f0 = 0.1\nbogus = 2"), "contact 'pad': unknown key 'bogus'"),
+    ];
+    for (i, (text, want)) in cases.iter().enumerate() {
+        let f = format!("bad{i}.toml");
+        std::fs::write(d.path().join(&f), text).unwrap();
+        let out = squeal(d.path(), &["simulate", &f, "--out", "never"]);
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "case {i}: {e}");
+        assert!(e.contains(want), "case {i}: expected '{want}' in: {e}");
+        assert_eq!(e.trim().lines().count(), 1, "one line: {e}");
+        assert!(!d.path().join("never").exists());
+    }
+    // Keys on the command line: unknown element, a value out of range.
+    let f = scenarios().join("disc-pad.toml");
+    let out = squeal(
+        d.path(),
+        &["stability", f.to_str().unwrap(), "--set", "pad.mu_k=0.1"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let out = squeal(
+        d.path(),
+        &["stability", f.to_str().unwrap(), "--set", "mass.x_p=-1"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("mass.x_p"));
+}
+
+#[test]
+fn sweep_of_the_lumped_hoffmann_finds_the_built_ins_coalescence() {
+    let d = tempfile::tempdir().unwrap();
+    let f = scenarios().join("hoffmann.toml");
+    let a = json(&squeal(
+        d.path(),
+        &[
+            "sweep",
+            f.to_str().unwrap(),
+            "--set",
+            "belt.mu_s=2",
+            "--param",
+            "belt.mu_k=0.1:0.5:41",
+            "--json",
+            "--out",
+            "a",
+        ],
+    ));
+    let b = json(&squeal(
+        d.path(),
+        &[
+            "sweep",
+            "hoffmann",
+            "--param",
+            "mu=0.1:0.5:41",
+            "--json",
+            "--out",
+            "b",
+        ],
+    ));
+    let (oa, ob) = (&a["onsets"][0], &b["onsets"][0]);
+    assert_eq!(oa["coalescence"], true);
+    let (x, y) = (oa["value"].as_f64().unwrap(), ob["value"].as_f64().unwrap());
+    assert!((x - y).abs() <= 1e-9 * y, "{x} vs {y}");
+    assert!(d.path().join("a/sweep.csv").is_file());
+}
