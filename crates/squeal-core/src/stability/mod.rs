@@ -463,9 +463,24 @@ where
                     }
                 }
             }
+            // The threshold for a coalescence: COALESCENCE_TOL, or less where the
+            // growing end's σ/|λ| is itself below it (just past the coalescence),
+            // so that g changes sign on the bracket; it stays above the neutral
+            // end's σ/|λ| (≤ NEUTRAL_TOL), and the root stays within ~tol² of
+            // the coalescence.
+            let ratio = |s: f64, fr: f64| {
+                let m = mag(s, fr);
+                if m > 0.0 {
+                    s / m
+                } else {
+                    0.0
+                }
+            };
+            let (ra, rb) = (ratio(sa, fa), ratio(sb, fb));
+            let tol = COALESCENCE_TOL.min(if ra > 0.0 { (ra * rb).sqrt() } else { 0.5 * rb });
             let g = |s: f64, fr: f64| {
                 if neutral {
-                    s - COALESCENCE_TOL * mag(s, fr)
+                    s - tol * mag(s, fr)
                 } else {
                     s
                 }
