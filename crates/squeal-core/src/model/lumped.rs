@@ -1151,41 +1151,34 @@ impl Lumped {
             )));
         }
         let modes = self.steady_modes();
-        let mut z = vec![0.0; 2 * n];
         let mut acc = vec![0.0; n];
-        for _ in 0..100 {
-            let (q, u) = z.split_at(n);
-            self.force(f64::INFINITY, &modes, q, u, &mut acc);
-            let jf = self.force_jacobian(&modes, &z);
-            let a = jf.columns(0, n).into_owned();
-            let b = nalgebra::DVector::from_iterator(n, acc.iter().map(|x| -x));
-            let dq = a.lu().solve(&b).ok_or_else(|| {
-                ModelError::NoSteadySliding("the steady-sliding equations are singular (is every dof held by a spring or a contact?)".into())
-            })?;
-            let size = z[..n].iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            let step = dq.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            for r in 0..n {
-                z[r] += dq[r];
-            }
-            if !step.is_finite() {
-                break;
-            }
-            if step <= 1e-14 * size.max(f64::MIN_POSITIVE) || step == 0.0 {
-                for (i, c) in self.contacts.iter().enumerate() {
-                    let f_n = c.normal_force(&z[..n], &z[n..]);
-                    if c.can_open() && f_n <= 0.0 {
-                        return Err(ModelError::NoSteadySliding(format!(
-                            "contact '{}': the normal force at steady sliding, {f_n:.3e} N, is not positive",
-                            self.contacts[i].name
-                        )));
-                    }
-                }
-                return Ok(z);
+        let mut z = vec![0.0; 2 * n];
+        let q = super::newton_positions(
+            &vec![0.0; n],
+            |q| {
+                z[..n].copy_from_slice(q);
+                let (q, u) = z.split_at(n);
+                self.force(f64::INFINITY, &modes, q, u, &mut acc);
+                let jf = self.force_jacobian(&modes, &z);
+                (
+                    jf.columns(0, n).into_owned(),
+                    nalgebra::DVector::from_column_slice(&acc),
+                )
+            },
+            "the steady-sliding equations are singular (is every dof held by a spring or a contact?)",
+        )?;
+        let mut z = vec![0.0; 2 * n];
+        z[..n].copy_from_slice(&q);
+        for c in &self.contacts {
+            let f_n = c.normal_force(&z[..n], &z[n..]);
+            if c.can_open() && f_n <= 0.0 {
+                return Err(ModelError::NoSteadySliding(format!(
+                    "contact '{}': the normal force at steady sliding, {f_n:.3e} N, is not positive",
+                    c.name
+                )));
             }
         }
-        Err(ModelError::NoSteadySliding(
-            "Newton's method did not converge on the steady-sliding state".into(),
-        ))
+        Ok(z)
     }
 
     /// Forces and sliding velocity of contact `i` (any size).

@@ -338,27 +338,53 @@ pub fn newton_equilibrium<M: Model<N> + ?Sized, const N: usize>(
     guess: &[f64; N],
 ) -> Result<[f64; N], ModelError> {
     let n = N / 2;
-    let mut z = [0.0; N];
-    z[..n].copy_from_slice(&guess[..n]);
     let mut f = [0.0; N];
+    let q = newton_positions(
+        &guess[..n],
+        |q| {
+            let mut z = [0.0; N];
+            z[..n].copy_from_slice(q);
+            model.rhs(f64::INFINITY, Mode::SlipPos, &z, &mut f);
+            let j = model.jacobian(&z);
+            (
+                nalgebra::DMatrix::from_fn(n, n, |r, c| j[n + r][c]),
+                nalgebra::DVector::from_fn(n, |r, _| f[n + r]),
+            )
+        },
+        "the steady-sliding equations are singular",
+    )?;
+    let mut z = [0.0; N];
+    z[..n].copy_from_slice(&q);
+    Ok(z)
+}
+
+/// Newton's method on positions `q` for `r(q) = 0`: `eval(q)` gives the
+/// Newton matrix `∂r/∂q` and the residual `r`; each iteration solves by LU
+/// with partial pivoting. Converges when the update is below 1e-14 of the
+/// positions' size (at most 100 iterations); a singular matrix is
+/// [`ModelError::NoSteadySliding`] with the message `singular`. Shared by
+/// [`newton_equilibrium`] and the lumped models' runtime-size equilibrium.
+pub fn newton_positions<F>(q0: &[f64], mut eval: F, singular: &str) -> Result<Vec<f64>, ModelError>
+where
+    F: FnMut(&[f64]) -> (nalgebra::DMatrix<f64>, nalgebra::DVector<f64>),
+{
+    let mut q = q0.to_vec();
     for _ in 0..100 {
-        model.rhs(f64::INFINITY, Mode::SlipPos, &z, &mut f);
-        let j = model.jacobian(&z);
-        let a = nalgebra::DMatrix::from_fn(n, n, |r, c| j[n + r][c]);
-        let b = nalgebra::DVector::from_fn(n, |r, _| -f[n + r]);
-        let dq = a.lu().solve(&b).ok_or_else(|| {
-            ModelError::NoSteadySliding("the steady-sliding equations are singular".into())
-        })?;
-        let size = z[..n].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let (a, r) = eval(&q);
+        let dq = a
+            .lu()
+            .solve(&(-r))
+            .ok_or_else(|| ModelError::NoSteadySliding(singular.into()))?;
+        let size = q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let step = dq.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        for r in 0..n {
-            z[r] += dq[r];
+        for (qi, d) in q.iter_mut().zip(dq.iter()) {
+            *qi += d;
         }
         if !step.is_finite() {
             break;
         }
         if step <= 1e-14 * size.max(f64::MIN_POSITIVE) || step == 0.0 {
-            return Ok(z);
+            return Ok(q);
         }
     }
     Err(ModelError::NoSteadySliding(
