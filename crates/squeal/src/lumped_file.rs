@@ -24,6 +24,21 @@ pub const LUMPED_KEYS: [&str; 6] = ["dofs", "masses", "spring", "force", "contac
 fn err<T>(msg: impl Into<String>) -> Result<T, InputError> {
     Err(InputError(msg.into()))
 }
+/// The value of a key an element must have.
+fn required<'a>(what: &str, t: &'a toml::Table, key: &str) -> Result<&'a toml::Value, InputError> {
+    t.get(key)
+        .ok_or_else(|| InputError(format!("{what}: {key}: missing")))
+}
+
+/// A number an element may leave out (`default` then).
+fn optional_number(
+    what: &str,
+    t: &toml::Table,
+    key: &str,
+    default: f64,
+) -> Result<f64, InputError> {
+    t.get(key).map_or(Ok(default), |v| number(what, key, v))
+}
 
 fn number(what: &str, key: &str, v: &toml::Value) -> Result<f64, InputError> {
     match v {
@@ -155,46 +170,18 @@ pub fn parse(
         let name = element_name("spring", i, t)?;
         let what = format!("spring '{name}'");
         check_keys(&what, t, &["name", "on", "k", "c"])?;
-        let on = terms(
-            &what,
-            "on",
-            t.get("on")
-                .ok_or_else(|| InputError(format!("{what}: on: missing")))?,
-        )?;
-        let k = number(
-            &what,
-            "k",
-            t.get("k")
-                .ok_or_else(|| InputError(format!("{what}: k: missing")))?,
-        )?;
-        let c = t
-            .get("c")
-            .map(|v| number(&what, "c", v))
-            .transpose()?
-            .unwrap_or(0.0);
+        let on = terms(&what, "on", required(&what, t, "on")?)?;
+        let k = number(&what, "k", required(&what, t, "k")?)?;
+        let c = optional_number(&what, t, "c", 0.0)?;
         spec.springs.push(SpringSpec { name, on, k, c });
     }
     for (i, t) in tables(table, "force")?.into_iter().enumerate() {
         let name = element_name("force", i, t)?;
         let what = format!("force '{name}'");
         check_keys(&what, t, &["name", "on", "value", "ramp"])?;
-        let on = terms(
-            &what,
-            "on",
-            t.get("on")
-                .ok_or_else(|| InputError(format!("{what}: on: missing")))?,
-        )?;
-        let value = number(
-            &what,
-            "value",
-            t.get("value")
-                .ok_or_else(|| InputError(format!("{what}: value: missing")))?,
-        )?;
-        let ramp = t
-            .get("ramp")
-            .map(|v| number(&what, "ramp", v))
-            .transpose()?
-            .unwrap_or(0.0);
+        let on = terms(&what, "on", required(&what, t, "on")?)?;
+        let value = number(&what, "value", required(&what, t, "value")?)?;
+        let ramp = optional_number(&what, t, "ramp", 0.0)?;
         spec.forces.push(ForceSpec {
             name,
             on,
