@@ -2,9 +2,7 @@
 //! thesis's spectral analyser showed them), growth rate, and a one-word
 //! verdict; and the pictures and sound made from them.
 
-use crate::model::Channels;
 use crate::run::{Run, RunError};
-use crate::scenario::InputError;
 use serde_json::{json, Map, Value};
 use squeal_plot::{Format, HeatmapSpec, Labels, Panel, Series};
 use squeal_signal::spectrum::Scaling;
@@ -14,6 +12,8 @@ use squeal_signal::{
     EventClass, GrowthOptions, JudgeOptions, Judgement, Peak, PeakOptions, RunEvent, RunRecord,
     RunVerdict, Spectrum, WelchOptions,
 };
+use squeal_study::model::Channels;
+use squeal_study::scenario::InputError;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -595,7 +595,7 @@ fn velocity_words(v: &str) -> String {
     } else {
         v.strip_prefix('v').unwrap_or(v)
     };
-    crate::model::coordinate_words(pos).map_or(v.to_string(), str::to_string)
+    squeal_study::model::coordinate_words(pos).map_or(v.to_string(), str::to_string)
 }
 
 /// Frequencies shown: (divisor, unit) — kHz when the shown range reaches 2 kHz.

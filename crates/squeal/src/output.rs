@@ -141,7 +141,7 @@ pub fn write_json(value: &Value, path: &Path) -> Result<(), RunError> {
 /// is the first after the header) and the column.
 fn check_series(dir: &Path, columns: &[String], data: &[Vec<f64>]) -> Result<(), RunError> {
     let bad = |msg: String| {
-        RunError::Input(crate::scenario::InputError(format!(
+        RunError::Input(squeal_study::scenario::InputError(format!(
             "run folder {}: {msg}",
             dir.display()
         )))
@@ -187,7 +187,7 @@ fn check_series(dir: &Path, columns: &[String], data: &[Vec<f64>]) -> Result<(),
 /// `series.csv`, or `series.npy` with the names from `summary.json`) and
 /// its summary.
 pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
-    let bad = |msg: String| RunError::Input(crate::scenario::InputError(msg));
+    let bad = |msg: String| RunError::Input(squeal_study::scenario::InputError(msg));
     if !dir.is_dir() {
         return Err(bad(format!("run folder {}: not a folder", dir.display())));
     }

@@ -7,13 +7,13 @@
 use crate::commands::cycle::{self, events_json, Found};
 use crate::commands::simulate::resolve;
 use crate::run::{RunError, Staging};
-use crate::scenario::{InputError, Scenario};
 use crate::ScenarioArgs;
 use clap::Args;
 use serde_json::{json, Value};
 use squeal_core::cycle::Section;
 use squeal_core::EventKind;
 use squeal_plot::{Format, Panel, Series};
+use squeal_study::scenario::{InputError, Scenario};
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
@@ -121,8 +121,8 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
     sc.model.check_simulable().map_err(InputError)?;
     // i9's validation path, the part that applies to a cycle (which budgets
     // its own settling): a linearisation that overflows is named by parameter.
-    crate::feasible::scales(&sc.model, Some(&sc))
-        .map_err(|e| crate::feasible::stability_failure(&sc.model, e))?;
+    squeal_study::feasible::scales(&sc.model, Some(&sc))
+        .map_err(|e| squeal_study::feasible::stability_failure(&sc.model, e))?;
     let values: Vec<f64> = (0..n)
         .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
         .collect();
@@ -249,7 +249,7 @@ fn continue_from(
         index,
         level: prev.section.1,
     };
-    crate::with_system!(&sc.model, m => {
+    squeal_study::with_system!(&sc.model, m => {
         cycle::find(m, &sc.model, &prev.z0, Some((&prev.z0, prev.period, section)), opts, false)
     }, else => Err(RunError::Numerical("not simulable".into())))
 }

@@ -4,13 +4,13 @@
 
 use crate::commands::simulate::resolve;
 use crate::commands::stability::stability_error;
-use crate::model::AnyModel;
 use crate::run::RunError;
-use crate::scenario::InputError;
 use crate::ScenarioArgs;
 use clap::Args;
 use serde_json::json;
 use squeal_core::stability::{self, CriticalOptions, Crossing, Direction, StabilityError};
+use squeal_study::model::AnyModel;
+use squeal_study::scenario::InputError;
 
 /// Arguments of `squeal critical`.
 #[derive(Args, Debug)]

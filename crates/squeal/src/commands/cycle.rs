@@ -4,15 +4,15 @@
 //! `squeal_core::cycle`.
 
 use crate::commands::simulate::resolve;
-use crate::model::{observe_all, AnyModel};
 use crate::run::{self, RunError, Staging};
-use crate::scenario::{InputError, Scenario};
 use crate::ScenarioArgs;
 use clap::Args;
 use serde_json::{json, Map, Value};
 use squeal_core::cycle::{self, CycleError, CycleOptions, Section};
 use squeal_core::{EventKind, System};
 use squeal_plot::{Format, Labels, Panel, Series};
+use squeal_study::model::{observe_all, AnyModel};
+use squeal_study::scenario::{InputError, Scenario};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
@@ -197,7 +197,7 @@ pub fn of_scenario(
     opts: &CycleOptions,
     with_orbit: bool,
 ) -> Result<Found, RunError> {
-    crate::with_system!(&sc.model, m => {
+    squeal_study::with_system!(&sc.model, m => {
         let z0 = run::initial_of(m, sc)?;
         find(m, &sc.model, &z0, None, opts, with_orbit)
     }, else => Err(RunError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))))
@@ -369,8 +369,8 @@ pub fn run(a: CycleArgs) -> Result<(), RunError> {
     sc.model.check_simulable().map_err(InputError)?;
     // i9's validation path, the part that applies to a cycle (which budgets
     // its own settling): a linearisation that overflows is named by parameter.
-    crate::feasible::scales(&sc.model, Some(&sc))
-        .map_err(|e| crate::feasible::stability_failure(&sc.model, e))?;
+    squeal_study::feasible::scales(&sc.model, Some(&sc))
+        .map_err(|e| squeal_study::feasible::stability_failure(&sc.model, e))?;
     let mut opts = options(&sc, a.settle_steps, a.settle_time);
     opts.settle_tol = a.settle_tol;
     if let Some(spec) = &a.section {

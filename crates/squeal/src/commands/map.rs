@@ -4,9 +4,7 @@
 
 use crate::commands::critical::growth_at;
 use crate::commands::simulate::{resolve, resolve_run};
-use crate::model::AnyModel;
 use crate::run::{progress_bar, RunError, Staging};
-use crate::scenario::{InputError, Scenario};
 use crate::ScenarioArgs;
 use clap::Args;
 use rayon::prelude::*;
@@ -16,6 +14,8 @@ use squeal_core::stability::StabilityError;
 use squeal_core::System;
 use squeal_core::{simulate, EventKind, Mode};
 use squeal_plot::{Colormap, Format, HeatmapSpec};
+use squeal_study::model::AnyModel;
+use squeal_study::scenario::{InputError, Scenario};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -133,7 +133,7 @@ pub fn linear_grid(
     model: &AnyModel,
     x: &Axis,
     y: &Axis,
-    progress: &indicatif::ProgressBar,
+    progress: &dyn squeal_study::Progress,
 ) -> Result<Vec<(f64, f64)>, RunError> {
     let nx = x.values.len();
     let points: Vec<Result<(f64, f64), RunError>> = (0..nx * y.values.len())
@@ -152,7 +152,7 @@ pub fn linear_grid(
                 Ok(p) => Ok(p),
                 Err(e @ StabilityError::NonFinite { .. }) => {
                     let _ = m.set(&x.name, x.values[i]);
-                    let why = crate::feasible::stability_failure(&m, e);
+                    let why = squeal_study::feasible::stability_failure(&m, e);
                     Err(RunError::Input(InputError(format!(
                         "at {} = {:e}, {} = {:e}: {why}",
                         x.name, x.values[i], y.name, y.values[j]
@@ -315,7 +315,7 @@ pub fn transient_grid(
     sc: &Scenario,
     x: &Axis,
     y: &Axis,
-    progress: &indicatif::ProgressBar,
+    progress: &dyn squeal_study::Progress,
 ) -> Vec<Outcome> {
     let nx = x.values.len();
     (0..nx * y.values.len())
@@ -330,9 +330,9 @@ pub fn transient_grid(
                 .and_then(|_| s.model.validate())
                 .map_err(|e| e.to_string())
                 // Each point gets its own step budget (its stiffness differs).
-                .and_then(|_| crate::feasible::prepare(&mut s).map_err(|e| e.to_string()))
+                .and_then(|_| squeal_study::feasible::prepare(&mut s).map_err(|e| e.to_string()))
                 .and_then(|_| {
-                    crate::with_system!(&s.model, m => transient_point(m, &s),
+                    squeal_study::with_system!(&s.model, m => transient_point(m, &s),
                     else => Err(s.model.check_simulable().err().unwrap_or_default()))
                 });
             progress.inc(1);
@@ -430,11 +430,11 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
     let n = x.values.len() * y.values.len();
     let pb = progress_bar(n as u64, "eigen-analysis");
     let lin = linear_grid(&sc.model, &x, &y, &pb)?;
-    pb.finish_and_clear();
+    squeal_study::Progress::finish(&pb);
     let trans = if a.transient {
         let pb = progress_bar(n as u64, "simulating");
         let t = transient_grid(&sc, &x, &y, &pb);
-        pb.finish_and_clear();
+        squeal_study::Progress::finish(&pb);
         Some(t)
     } else {
         None

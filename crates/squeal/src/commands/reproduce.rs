@@ -3,7 +3,7 @@
 //! (reconstructed, `scenarios/thesis/`), Appendix A's pictures for each set
 //! (the disc as the thesis drew it, the pad beside it) plus its eigenvalues,
 //! the seven conclusions of docs/physics.md §6 turned into measurable claims,
-//! evaluated on this invocation's runs and on the studies of [`crate::study`]
+//! evaluated on this invocation's runs and on the studies of [`squeal_study::study`]
 //! (α sweep, c_px sweep, a kick above Uc), each graded `held`, `held
 //! qualitatively`, `held by another mechanism`, `refuted` or `outside the
 //! model`; runs that leave the model (`lift-off`, `out-of-range`) are flagged
@@ -14,10 +14,7 @@
 
 use crate::analysis::{self, Analysis};
 use crate::commands::stability::analyse as eigen_analyse;
-use crate::model::AnyModel;
 use crate::run::{self, progress_bar, Run, RunError, Staging};
-use crate::scenario::{InputError, Scenario, Setting};
-use crate::study::{self, AboveUc, AlphaSweep, CpxSweep, StickStats};
 use clap::Args;
 use rayon::prelude::*;
 use serde_json::{json, Value};
@@ -25,6 +22,9 @@ use squeal_core::stability;
 use squeal_core::{EventKind, Model};
 use squeal_plot::{Colormap, Format, HeatmapSpec};
 use squeal_signal::Spectrum;
+use squeal_study::model::AnyModel;
+use squeal_study::scenario::{InputError, Scenario, Setting};
+use squeal_study::study::{self, AboveUc, AlphaSweep, CpxSweep, StickStats};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -44,7 +44,7 @@ pub struct ReproduceArgs {
     no_figures: bool,
 }
 
-use crate::scenario::thesis_sets;
+use squeal_study::scenario::thesis_sets;
 
 /// Linear stability of one set (sets at V = 0 have no steady sliding).
 #[derive(Debug, Clone)]
@@ -189,7 +189,7 @@ fn measure(id: usize, sc: Scenario, figures: Option<&Path>) -> Result<SetResult,
         Ok(l) => (Some(l), String::new()),
         Err(e) => (None, e),
     };
-    let run: Run = run::run_with(&sc, &indicatif::ProgressBar::hidden())?;
+    let run: Run = squeal_study::run::run(&sc, &squeal_study::NoProgress, &run::NEVER)?;
     let ch = sc.model.channels();
     let an: Analysis = analysis::analyse(
         &run,
@@ -477,8 +477,8 @@ fn sweeps(set15: &Scenario) -> Result<Sweeps, RunError> {
         _ => None,
     };
     let (cpx, kicked) = rayon::join(
-        || study::cpx_sweep(set15, &CPX_FACTORS, CPX_DURATION),
-        || study::above_uc(set15, KICK_DURATION),
+        || study::cpx_sweep(set15, &CPX_FACTORS, CPX_DURATION, &run::NEVER),
+        || study::above_uc(set15, KICK_DURATION, &run::NEVER),
     );
     let (cpx, kicked) = (cpx?, kicked?);
     let ch = base.channels();
@@ -1731,7 +1731,7 @@ pub fn run(a: ReproduceArgs) -> Result<(), RunError> {
     for s in &mut sets {
         let d = s.duration * a.duration_scale;
         s.apply("duration", &Setting::Number(d))?;
-        crate::feasible::prepare(s)?;
+        squeal_study::feasible::prepare(s)?;
     }
     let stage = Staging::new(&a.out)?;
     let figures = stage.dir().join("figures");
@@ -1741,11 +1741,11 @@ pub fn run(a: ReproduceArgs) -> Result<(), RunError> {
         .enumerate()
         .map(|(i, sc)| {
             let r = measure(i + 1, sc, (!a.no_figures).then_some(figures.as_path()));
-            pb.inc(1);
+            squeal_study::Progress::inc(&pb, 1);
             r
         })
         .collect();
-    pb.finish_and_clear();
+    squeal_study::Progress::finish(&pb);
     let mut rs = Vec::new();
     for (i, r) in results.into_iter().enumerate() {
         rs.push(r.map_err(|e| RunError::Numerical(format!("set {}: {e}", i + 1)))?);

@@ -1,11 +1,11 @@
 //! `squeal simulate [SCENARIO] [--set NAME=VALUE]... [--duration S] [--out DIR]`.
 
 use crate::run::{self, RunError, Staging};
-use crate::scenario::{InputError, Scenario, Setting};
 use crate::ScenarioArgs;
 use crate::{analysis, output};
 use clap::Args;
 use serde_json::json;
+use squeal_study::scenario::{InputError, Scenario, Setting};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -87,21 +87,21 @@ impl SpectrumArgs {
 
 /// Resolve the scenario named on the command line, with its overrides.
 pub fn resolve(args: &ScenarioArgs) -> Result<Scenario, InputError> {
-    crate::scenario::check_set_syntax(&args.sets, &args.scenario)?;
+    squeal_study::scenario::check_set_syntax(&args.sets, &args.scenario)?;
     let mut sc = Scenario::load(&args.scenario)?;
     sc.apply_overrides(&args.sets)?;
     Ok(sc)
 }
 
 /// Resolve a scenario for a run — with `--duration` if given — and check it
-/// the one way every simulating command does ([`crate::feasible::prepare`]).
+/// the one way every simulating command does ([`squeal_study::feasible::prepare`]).
 pub fn resolve_run(args: &ScenarioArgs, duration: Option<f64>) -> Result<Scenario, RunError> {
     let mut sc = resolve(args)?;
     if let Some(d) = duration {
         sc.apply("duration", &Setting::Number(d))
             .map_err(|e| InputError(format!("--duration: {}", e.0)))?;
     }
-    crate::feasible::prepare(&mut sc)?;
+    squeal_study::feasible::prepare(&mut sc)?;
     Ok(sc)
 }
 
@@ -204,7 +204,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
             serde_json::to_string_pretty(&summary).map_err(|e| RunError::Io(e.to_string()))?
         );
     } else {
-        crate::outln!("{}", an.squeal_line(crate::model::coordinate_words));
+        crate::outln!("{}", an.squeal_line(squeal_study::model::coordinate_words));
         print_human(&sc, &run, &summary, &dest);
     }
     if let Some(note) = hearing {

@@ -5,13 +5,12 @@
 //! verdict (MODEL.md §5).
 
 use crate::commands::simulate::resolve;
-use crate::model::AnyModel;
 use crate::run::RunError;
-use crate::scenario::InputError;
 use crate::ScenarioArgs;
 use clap::Args;
 use serde_json::{json, Value};
 use squeal_core::stability::{self, Analysis, CriticalOptions, StabilityError};
+use squeal_study::model::AnyModel;
 
 /// Arguments of `squeal stability`.
 #[derive(Args, Debug)]
@@ -74,13 +73,7 @@ pub fn write_modes_csv(
 /// A stability failure as a command error: no steady sliding or bad
 /// parameters are input errors (exit 2), anything else a run failure.
 pub fn stability_error(e: StabilityError) -> RunError {
-    match e {
-        StabilityError::NoSteadySliding(_)
-        | StabilityError::Param(_)
-        | StabilityError::NonFinite { .. }
-        | StabilityError::BadInterval { .. } => RunError::Input(InputError(e.to_string())),
-        other => RunError::Numerical(other.to_string()),
-    }
+    squeal_study::feasible::stability_error(e).into()
 }
 
 /// Full analysis of any model, with mass-weighted mode attribution.
@@ -239,7 +232,8 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     if let Some(dest) = &a.out {
         crate::staging::check_dest_as("--out", dest)?;
     }
-    let an = analyse(&sc.model).map_err(|e| crate::feasible::stability_failure(&sc.model, e))?;
+    let an =
+        analyse(&sc.model).map_err(|e| squeal_study::feasible::stability_failure(&sc.model, e))?;
     if let Some(dest) = &a.out {
         let stage = crate::run::Staging::new_as("--out", dest)?;
         write_modes_csv(&stage.path("modes.csv"), &sc.model, &an)?;

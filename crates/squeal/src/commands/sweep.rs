@@ -5,9 +5,7 @@
 
 use crate::commands::map::{parse_axis, unit_of};
 use crate::commands::simulate::resolve;
-use crate::model::AnyModel;
 use crate::run::{RunError, Staging};
-use crate::scenario::InputError;
 use crate::ScenarioArgs;
 use clap::Args;
 use nalgebra::DMatrix;
@@ -15,6 +13,8 @@ use serde_json::json;
 use squeal_core::stability::sweep::{sweep, Sweep, SweepOptions};
 use squeal_core::stability::{state_matrix, Direction, StabilityError};
 use squeal_plot::{BranchSeries, Format, ModeCouplingSpec};
+use squeal_study::model::AnyModel;
+use squeal_study::scenario::InputError;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -36,7 +36,7 @@ pub struct SweepArgs {
 
 /// The state matrix `A = ∂f/∂z` and equilibrium of any model, as runtime-sized values.
 pub fn model_state_matrix(model: &AnyModel) -> Result<(DMatrix<f64>, Vec<f64>), StabilityError> {
-    crate::with_model!(model, m => {
+    squeal_study::with_model!(model, m => {
         let (z, a) = state_matrix(m)?;
         let n = z.len();
         Ok((DMatrix::from_fn(n, n, |i, j| a[i][j]), z.to_vec()))
