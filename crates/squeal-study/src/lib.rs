@@ -7,15 +7,19 @@
 //! own Matrix Market inputs are read). Long computations take a [`Cancel`]
 //! token and report to a [`Progress`]; failures are [`StudyError`]s.
 
+pub mod critical;
 pub mod error;
 pub mod feasible;
 pub mod lumped_file;
+pub mod map;
 pub mod model;
 pub mod run;
 pub mod scenario;
 #[cfg(test)]
 mod scenario_props;
+pub mod stability;
 pub mod study;
+pub mod sweep;
 
 pub use error::{Cancel, NoProgress, Progress, StudyError};
 pub use model::AnyModel;

@@ -159,7 +159,7 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
     }
     // The linear picture: where steady sliding changes stability in the
     // range (`critical`'s Hopf point), and the branch's point nearest to it.
-    let hopf = crate::commands::critical::locate(&sc.model, &name, lo, hi, 64)
+    let hopf = squeal_study::critical::locate(&sc.model, &name, lo, hi, 64, &crate::run::NEVER)
         .ok()
         .flatten()
         .map(|c| {

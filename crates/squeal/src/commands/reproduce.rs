@@ -13,7 +13,6 @@
 //! wall-clock time: the same input gives byte-identical files.
 
 use crate::analysis::{self, Analysis};
-use crate::commands::stability::analyse as eigen_analyse;
 use crate::run::{self, progress_bar, Run, RunError, Staging};
 use clap::Args;
 use rayon::prelude::*;
@@ -24,6 +23,7 @@ use squeal_plot::{Colormap, Format, HeatmapSpec};
 use squeal_signal::Spectrum;
 use squeal_study::model::AnyModel;
 use squeal_study::scenario::{InputError, Scenario, Setting};
+use squeal_study::stability::analyse as eigen_analyse;
 use squeal_study::study::{self, AboveUc, AlphaSweep, CpxSweep, StickStats};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
