@@ -7,7 +7,9 @@
 //! own Matrix Market inputs are read). Long computations take a [`Cancel`]
 //! token and report to a [`Progress`]; failures are [`StudyError`]s.
 
+pub mod branch;
 pub mod critical;
+pub mod cycle;
 pub mod error;
 pub mod feasible;
 pub mod lumped_file;

@@ -8,7 +8,7 @@ use std::io::IsTerminal;
 use std::time::Instant;
 
 pub use crate::staging::Staging;
-pub use squeal_study::run::{initial_of, Run};
+pub use squeal_study::run::Run;
 
 /// Why a command failed: bad input (exit code 2) or trouble during the run (exit code 1).
 #[derive(Debug, thiserror::Error)]
