@@ -20,7 +20,7 @@ pub enum StudyError {
 
 /// A cancellation token: set it from another thread (a Ctrl-C handler) and
 /// every long computation that was given it stops soon after with
-/// [`StudyError::Interrupted`] (a simulation checks it every few thousand
+/// [`StudyError::Interrupted`] (a simulation checks it every thousand
 /// samples, a grid before every point).
 #[derive(Debug, Default)]
 pub struct Cancel(AtomicBool);

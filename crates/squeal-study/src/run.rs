@@ -10,7 +10,7 @@ use squeal_core::model::{Modes, Observables};
 use squeal_core::{simulate, EventKind, Mode, RunInfo, System};
 
 /// How many samples pass between two looks at the [`Cancel`] token.
-const CANCEL_EVERY: u32 = 4096;
+const CANCEL_EVERY: u32 = 1024;
 
 /// A finished run: uniformly sampled columns and the event list.
 #[derive(Debug, Clone)]

@@ -5,7 +5,7 @@ use crate::ScenarioArgs;
 use crate::{analysis, output};
 use clap::Args;
 use serde_json::json;
-use squeal_study::scenario::{InputError, Scenario, Setting};
+use squeal_study::scenario::{InputError, Scenario, Source};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -87,22 +87,17 @@ impl SpectrumArgs {
 
 /// Resolve the scenario named on the command line, with its overrides.
 pub fn resolve(args: &ScenarioArgs) -> Result<Scenario, InputError> {
-    squeal_study::scenario::check_set_syntax(&args.sets, &args.scenario)?;
-    let mut sc = Scenario::load(&args.scenario)?;
-    sc.apply_overrides(&args.sets)?;
-    Ok(sc)
+    squeal_study::scenario::resolve(Source::Spec(&args.scenario), &args.sets)
 }
 
 /// Resolve a scenario for a run — with `--duration` if given — and check it
 /// the one way every simulating command does ([`squeal_study::feasible::prepare`]).
 pub fn resolve_run(args: &ScenarioArgs, duration: Option<f64>) -> Result<Scenario, RunError> {
-    let mut sc = resolve(args)?;
-    if let Some(d) = duration {
-        sc.apply("duration", &Setting::Number(d))
-            .map_err(|e| InputError(format!("--duration: {}", e.0)))?;
-    }
-    squeal_study::feasible::prepare(&mut sc)?;
-    Ok(sc)
+    Ok(squeal_study::scenario::resolve_run(
+        Source::Spec(&args.scenario),
+        &args.sets,
+        duration,
+    )?)
 }
 
 /// Run the command.
