@@ -7,6 +7,7 @@
 //! own Matrix Market inputs are read). Long computations take a [`Cancel`]
 //! token and report to a [`Progress`]; failures are [`StudyError`]s.
 
+pub mod analysis;
 pub mod branch;
 pub mod critical;
 pub mod cycle;
