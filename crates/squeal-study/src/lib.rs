@@ -16,6 +16,7 @@ pub mod feasible;
 pub mod lumped_file;
 pub mod map;
 pub mod model;
+pub mod reproduce;
 pub mod run;
 pub mod scenario;
 #[cfg(test)]
