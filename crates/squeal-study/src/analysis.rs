@@ -6,7 +6,9 @@
 use crate::model::Channels;
 use crate::run::Run;
 use crate::scenario::InputError;
+use crate::scenario::Scenario;
 use serde_json::{json, Map, Value};
+use squeal_core::EventKind;
 use squeal_signal::spectrum::Scaling;
 use squeal_signal::window::Window;
 use squeal_signal::{
@@ -513,4 +515,66 @@ pub fn si(x: f64, unit: &str, digits: usize) -> String {
     };
     let dec = digits.saturating_sub(int_digits);
     format!("{v:.dec$} {prefix}{unit}")
+}
+
+/// RMS of each velocity column over the last 20 % of the run.
+pub fn tail_rms(run: &Run, velocity_columns: &[String]) -> Map<String, Value> {
+    let n = run.len();
+    let start = n - n / 5;
+    let mut out = Map::new();
+    for name in velocity_columns {
+        if let Some(col) = run.column(name) {
+            let tail = &col[start.min(n)..];
+            let rms = if tail.is_empty() {
+                0.0
+            } else {
+                (tail.iter().map(|x| x * x).sum::<f64>() / tail.len() as f64).sqrt()
+            };
+            out.insert(name.clone(), json!(rms));
+        }
+    }
+    out
+}
+
+/// The parts of summary.json that describe the integration.
+pub fn integrator_json(run: &Run) -> Value {
+    let s = &run.info.stats;
+    let mut events = Map::new();
+    for k in EventKind::ALL {
+        events.insert(k.as_str().into(), json!(s.event_count(k)));
+    }
+    json!({
+        "integrator": {
+            "method": "DOP853 with dense-output event location",
+            "accepted_steps": s.accepted,
+            "rejected_steps": s.rejected,
+            "rhs_evaluations": s.rhs_evals,
+            "rhs_per_step": if s.accepted > 0 { s.rhs_evals as f64 / s.accepted as f64 } else { 0.0 },
+        },
+        "events": events,
+        "stick_fraction": s.stick_fraction(),
+        "t_final": run.info.t_final,
+    })
+}
+
+/// The document `summary.json` holds for a run of `sc` analysed as `an`:
+/// the integration (`integrator`, `events`, `stick_fraction`, `t_final`),
+/// `scenario`, `columns`, the tail `rms` of every velocity, `spectrum`,
+/// `growth_rate`, `verdict`, `verdict_detail` and `squeal`. The CLI adds
+/// `audio` and `timing`.
+pub fn summary_json(sc: &Scenario, run: &Run, an: &Analysis) -> Value {
+    let velocity_names: Vec<String> = {
+        let names = sc.model.state_names();
+        names[names.len() / 2..].to_vec()
+    };
+    let mut summary = integrator_json(run);
+    summary["scenario"] = sc.to_json();
+    summary["columns"] = json!(run.columns);
+    summary["rms"] = json!(tail_rms(run, &velocity_names));
+    summary["spectrum"] = an.spectrum_json();
+    summary["growth_rate"] = an.growth_json();
+    summary["verdict"] = json!(an.verdict.as_str());
+    summary["verdict_detail"] = an.verdict_detail_json();
+    summary["squeal"] = an.squeal_json();
+    summary
 }

@@ -1,7 +1,7 @@
 //! Writing a run: `series.csv` (or `series.npy`), `events.csv`, `summary.json`.
 
 use crate::run::{Run, RunError};
-use serde_json::{json, Map, Value};
+use serde_json::Value;
 use squeal_core::EventKind;
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -86,46 +86,6 @@ pub fn write_events_csv(run: &Run, path: &Path) -> Result<(), RunError> {
         w.flush()
     })();
     res.map_err(|e| io_err(path, e))
-}
-
-/// RMS of each velocity column over the last 20 % of the run.
-pub fn tail_rms(run: &Run, velocity_columns: &[String]) -> Map<String, Value> {
-    let n = run.len();
-    let start = n - n / 5;
-    let mut out = Map::new();
-    for name in velocity_columns {
-        if let Some(col) = run.column(name) {
-            let tail = &col[start.min(n)..];
-            let rms = if tail.is_empty() {
-                0.0
-            } else {
-                (tail.iter().map(|x| x * x).sum::<f64>() / tail.len() as f64).sqrt()
-            };
-            out.insert(name.clone(), json!(rms));
-        }
-    }
-    out
-}
-
-/// The parts of summary.json that describe the integration.
-pub fn integrator_json(run: &Run) -> Value {
-    let s = &run.info.stats;
-    let mut events = Map::new();
-    for k in EventKind::ALL {
-        events.insert(k.as_str().into(), json!(s.event_count(k)));
-    }
-    json!({
-        "integrator": {
-            "method": "DOP853 with dense-output event location",
-            "accepted_steps": s.accepted,
-            "rejected_steps": s.rejected,
-            "rhs_evaluations": s.rhs_evals,
-            "rhs_per_step": if s.accepted > 0 { s.rhs_evals as f64 / s.accepted as f64 } else { 0.0 },
-        },
-        "events": events,
-        "stick_fraction": s.stick_fraction(),
-        "t_final": run.info.t_final,
-    })
 }
 
 /// Write a JSON document, pretty-printed, with a final newline.

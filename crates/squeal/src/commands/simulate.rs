@@ -142,17 +142,6 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         output::write_series_npy(&run, &stage.path("series.npy"))?;
     }
     output::write_events_csv(&run, &stage.path("events.csv"))?;
-    let velocity_names: Vec<String> = {
-        let names = sc.model.state_names();
-        names[names.len() / 2..]
-            .iter()
-            .map(|s| s.to_string())
-            .collect()
-    };
-    let mut summary = output::integrator_json(&run);
-    summary["scenario"] = sc.to_json();
-    summary["columns"] = json!(run.columns);
-    summary["rms"] = json!(output::tail_rms(&run, &velocity_names));
     let channels = sc.model.channels();
     let an = analysis::analyse(
         &run,
@@ -162,11 +151,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         a.spectrum.signals(),
     );
     analysis::write_spectrum_csv(&an, &stage.path("spectrum.csv"))?;
-    summary["spectrum"] = an.spectrum_json();
-    summary["growth_rate"] = an.growth_json();
-    summary["verdict"] = json!(an.verdict.as_str());
-    summary["verdict_detail"] = an.verdict_detail_json();
-    summary["squeal"] = an.squeal_json();
+    let mut summary = analysis::summary_json(&sc, &run, &an);
     if !a.no_plots {
         analysis::draw(&run, &an, &channels, &sc.name, stage.dir(), &plot_settings)?;
     }
