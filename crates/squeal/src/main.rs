@@ -42,6 +42,8 @@ enum Command {
     Stability(commands::stability::StabilityArgs),
     /// Stability map over a grid of two parameters (linear, or --transient by simulation).
     Map(commands::map::MapArgs),
+    /// Gather the shards of a map (`map … --shard K/N`) into the map the unsharded run writes.
+    Merge(commands::merge::MergeArgs),
     /// Locate the parameter value where steady sliding changes stability.
     Critical(commands::critical::CriticalArgs),
     /// The limit cycle a scenario settles on: period, Floquet multipliers, amplitudes, events.
@@ -76,6 +78,7 @@ fn main() -> ExitCode {
         Command::Reproduce(a) => commands::reproduce::run(a),
         Command::Stability(a) => commands::stability::run(a),
         Command::Map(a) => commands::map::run(a),
+        Command::Merge(a) => commands::merge::run(a),
         Command::Critical(a) => commands::critical::run(a),
         Command::Sweep(a) => commands::sweep::run(a),
         Command::Listen(a) => commands::listen::run(a),

@@ -5,6 +5,7 @@ pub mod critical;
 pub mod cycle;
 pub mod listen;
 pub mod map;
+pub mod merge;
 pub mod plot;
 pub mod reproduce;
 pub mod scenario;

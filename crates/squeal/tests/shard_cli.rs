@@ -1,0 +1,225 @@
+//! `squeal map … --shard K/N` and `squeal merge`: a merged map is the
+//! unsharded one byte for byte; shards of another study, missing,
+//! duplicated or truncated shards are refused (exit 2) with the reason.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn squeal_raw(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_squeal"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("squeal runs")
+}
+
+fn squeal(dir: &Path, args: &[&str]) -> Output {
+    let out = squeal_raw(dir, args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// Exit code 2, one line naming `why`, and nothing written at `out`.
+fn refused(dir: &Path, args: &[&str], why: &str) {
+    let out = squeal_raw(dir, args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert!(err.contains(why), "{args:?}: expected {why:?} in {err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(!dir.join("merged").exists(), "nothing written");
+}
+
+const LINEAR: [&str; 5] = ["map", "--x", "V=0.5:20:5", "--y", "N=100:3000:4"];
+const TRANSIENT: [&str; 9] = [
+    "map",
+    "belt",
+    "--x",
+    "V=2:16:4",
+    "--y",
+    "c=0.05:1:3",
+    "--transient",
+    "--duration",
+    "1.5",
+];
+
+fn with<'a>(base: &[&'a str], more: &[&'a str]) -> Vec<&'a str> {
+    base.iter().chain(more).copied().collect()
+}
+
+/// Shard `base` into `n` (into `DIR/s{n}-{k}`), merge into `DIR/m{n}`, and
+/// compare every file with the unsharded run in `DIR/full`.
+fn shards_merge_to_the_unsharded_map(base: &[&str], files: &[&str]) {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    squeal(dir, &with(base, &["--out", "full"]));
+    for n in [1usize, 2, 3, 7] {
+        let mut dirs = Vec::new();
+        for k in 0..n {
+            let out = format!("s{n}-{k}");
+            let shard = format!("{k}/{n}");
+            squeal(dir, &with(base, &["--shard", &shard, "--out", &out]));
+            dirs.push(out);
+        }
+        let m = format!("m{n}");
+        // Shards in any order.
+        dirs.reverse();
+        let mut args: Vec<&str> = vec!["merge"];
+        args.extend(dirs.iter().map(String::as_str));
+        args.extend(["--out", &m]);
+        let out = squeal(dir, &args);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            text.contains(&format!("points from {n} shards; 0 failed points")),
+            "{text}"
+        );
+        for f in files {
+            let a = std::fs::read(dir.join("full").join(f)).unwrap();
+            let b = std::fs::read(dir.join(&m).join(f)).unwrap();
+            assert!(a == b, "{f} differs after merging {n} shards");
+        }
+    }
+}
+
+#[test]
+fn linear_shards_merge_byte_identical() {
+    // 20 points: 20 / 3 and 20 / 7 leave uneven slices.
+    shards_merge_to_the_unsharded_map(&LINEAR, &["map.csv", "map.png", "map.svg"]);
+}
+
+#[test]
+fn transient_shards_merge_byte_identical() {
+    // 12 points: slices of 4 / 4 / 4 and 2 / 2 / 2 / 2 / 2 / 1 / 1.
+    shards_merge_to_the_unsharded_map(
+        &TRANSIENT,
+        &[
+            "map.csv",
+            "map.png",
+            "map.svg",
+            "transient.png",
+            "transient.svg",
+        ],
+    );
+}
+
+fn three_shards(dir: &Path, base: &[&str], prefix: &str) {
+    for k in 0..3 {
+        let (shard, out) = (format!("{k}/3"), format!("{prefix}{k}"));
+        squeal(dir, &with(base, &["--shard", &shard, "--out", &out]));
+    }
+}
+
+#[test]
+fn merge_refuses_missing_duplicated_and_foreign_shards() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    three_shards(dir, &LINEAR, "a");
+    let m = ["--out", "merged"];
+    // Shard 1 of 3 holds points 1, 4, 7, … 19.
+    refused(
+        dir,
+        &with(&["merge", "a0", "a2"], &m),
+        "missing shard 1/3 (points 1, 4, 7, 10, 13, 16, 19)",
+    );
+    refused(
+        dir,
+        &with(&["merge", "a0", "a1", "a1", "a2"], &m),
+        "shard 1/3 given twice",
+    );
+    // Another scenario (a changed parameter) and another grid.
+    squeal(
+        dir,
+        &with(
+            &LINEAR,
+            &["--set", "m_p=0.2", "--shard", "1/3", "--out", "b1"],
+        ),
+    );
+    refused(
+        dir,
+        &with(&["merge", "a0", "b1", "a2"], &m),
+        "different scenarios",
+    );
+    let other_grid = ["map", "--x", "V=0.5:20:5", "--y", "N=100:3100:4"];
+    squeal(dir, &with(&other_grid, &["--shard", "1/3", "--out", "g1"]));
+    refused(
+        dir,
+        &with(&["merge", "a0", "g1", "a2"], &m),
+        "different grids",
+    );
+    squeal(dir, &with(&LINEAR, &["--shard", "1/2", "--out", "n1"]));
+    refused(
+        dir,
+        &with(&["merge", "a0", "n1", "a2"], &m),
+        "different numbers of shards",
+    );
+    // All good: it merges.
+    squeal(dir, &with(&["merge", "a0", "a1", "a2"], &m));
+}
+
+#[test]
+fn merge_refuses_truncated_and_half_written_shards() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    three_shards(dir, &TRANSIENT, "t");
+    let m = ["--out", "merged"];
+    let part = dir.join("t1/part.csv");
+    let text = std::fs::read_to_string(&part).unwrap();
+    std::fs::write(&part, &text[..text.len() - 20]).unwrap();
+    refused(
+        dir,
+        &with(&["merge", "t0", "t1", "t2"], &m),
+        "t1: part.csv is truncated or changed",
+    );
+    // A folder without its manifest (as a killed job could leave) is no shard.
+    std::fs::remove_file(dir.join("t2/shard.json")).unwrap();
+    refused(
+        dir,
+        &with(&["merge", "t0", "t2"], &m),
+        "t2: not a complete shard",
+    );
+    // A truncated manifest.
+    let man = dir.join("t0/shard.json");
+    let text = std::fs::read_to_string(&man).unwrap();
+    std::fs::write(&man, &text[..text.len() / 2]).unwrap();
+    refused(
+        dir,
+        &with(&["merge", "t0"], &m),
+        "t0: shard.json is damaged",
+    );
+}
+
+#[test]
+fn a_failed_shard_is_recomputed_alone() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    squeal(dir, &with(&TRANSIENT, &["--out", "full"]));
+    three_shards(dir, &TRANSIENT, "t");
+    // Shard 1 is damaged; recomputing just it (into the same
+    // folder, which it replaces) repairs the study.
+    std::fs::write(dir.join("t1/part.csv"), "index\n").unwrap();
+    refused(
+        dir,
+        &["merge", "t0", "t1", "t2", "--out", "merged"],
+        "truncated or changed",
+    );
+    squeal(dir, &with(&TRANSIENT, &["--shard", "1/3", "--out", "t1"]));
+    squeal(dir, &["merge", "t0", "t1", "t2", "--out", "merged"]);
+    let a = std::fs::read(dir.join("full/map.csv")).unwrap();
+    let b = std::fs::read(dir.join("merged/map.csv")).unwrap();
+    assert!(a == b);
+}
+
+#[test]
+fn shard_flag_is_checked() {
+    let d = tempfile::tempdir().unwrap();
+    for bad in ["3/3", "1/0", "one/2"] {
+        let out = squeal_raw(d.path(), &with(&LINEAR, &["--shard", bad, "--out", "s"]));
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(&format!("--shard {bad}")), "{err}");
+        assert!(!d.path().join("s").exists());
+    }
+}
