@@ -44,6 +44,11 @@ enum Command {
     Map(commands::map::MapArgs),
     /// Gather the shards of a map (`map … --shard K/N`) into the map the unsharded run writes.
     Merge(commands::merge::MergeArgs),
+    /// Prepare (and with --submit, submit) a SLURM job array that computes a map in shards, and its merge job.
+    Slurm {
+        #[command(subcommand)]
+        what: commands::slurm::SlurmCmd,
+    },
     /// Locate the parameter value where steady sliding changes stability.
     Critical(commands::critical::CriticalArgs),
     /// The limit cycle a scenario settles on: period, Floquet multipliers, amplitudes, events.
@@ -79,6 +84,7 @@ fn main() -> ExitCode {
         Command::Stability(a) => commands::stability::run(a),
         Command::Map(a) => commands::map::run(a),
         Command::Merge(a) => commands::merge::run(a),
+        Command::Slurm { what } => commands::slurm::run(what),
         Command::Critical(a) => commands::critical::run(a),
         Command::Sweep(a) => commands::sweep::run(a),
         Command::Listen(a) => commands::listen::run(a),

@@ -223,3 +223,82 @@ fn shard_flag_is_checked() {
         assert!(!d.path().join("s").exists());
     }
 }
+
+#[test]
+fn slurm_scripts_run_as_an_array_and_merge() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    squeal(dir, &with(&LINEAR, &["--out", "full"]));
+    let args = with(
+        &LINEAR,
+        &[
+            "--tasks",
+            "3",
+            "--partition",
+            "short",
+            "--time",
+            "0:10:00",
+            "--cpus-per-task",
+            "2",
+            "--out",
+            "merged",
+        ],
+    );
+    let mut slurm = vec!["slurm"];
+    slurm.extend(&args);
+    let out = squeal(dir, &slurm);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("sbatch --array=K"), "{text}");
+    let array = std::fs::read_to_string(dir.join("merged-slurm/array.sh")).unwrap();
+    for line in [
+        "#SBATCH --array=0-2",
+        "#SBATCH --partition=short",
+        "#SBATCH --time=0:10:00",
+        "#SBATCH --cpus-per-task=2",
+        "export RAYON_NUM_THREADS=\"${SLURM_CPUS_PER_TASK:-1}\"",
+    ] {
+        assert!(array.lines().any(|l| l == line), "{line} not in {array}");
+    }
+    assert!(array.contains("--shard \"$K/3\""), "{array}");
+    // Run the scripts the way SLURM would: every task, then the merge.
+    let bash = |script: &str, task: Option<usize>| {
+        let mut c = Command::new("bash");
+        c.current_dir(dir)
+            .arg(dir.join("merged-slurm").join(script));
+        if let Some(k) = task {
+            c.env("SLURM_ARRAY_TASK_ID", k.to_string());
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    for k in 0..3 {
+        bash("array.sh", Some(k));
+    }
+    bash("merge.sh", None);
+    for f in ["map.csv", "map.png", "map.svg"] {
+        let a = std::fs::read(dir.join("full").join(f)).unwrap();
+        let b = std::fs::read(dir.join("merged").join(f)).unwrap();
+        assert!(a == b, "{f}");
+    }
+}
+
+#[test]
+fn slurm_refuses_bad_job_settings() {
+    let d = tempfile::tempdir().unwrap();
+    for (more, why) in [
+        (&["--tasks", "0"][..], "--tasks 0"),
+        (&["--tasks", "2", "--shard", "0/2"][..], "--shard"),
+        (&["--tasks", "2", "--time", "1 day"][..], "--time"),
+        (
+            &["--tasks", "2", "--cpus-per-task", "0"][..],
+            "--cpus-per-task 0",
+        ),
+    ] {
+        let mut args = vec!["slurm"];
+        args.extend(&LINEAR);
+        args.extend(more);
+        args.extend(["--out", "merged"]);
+        refused(d.path(), &args, why);
+        assert!(!d.path().join("merged-slurm").exists());
+    }
+}

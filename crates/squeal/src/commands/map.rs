@@ -14,6 +14,7 @@ use squeal_study::map::{
     CLASSES,
 };
 use squeal_study::scenario::InputError;
+use squeal_study::Scenario;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -268,9 +269,9 @@ pub fn report(
     Ok(())
 }
 
-/// Run the command.
-pub fn run(a: MapArgs) -> Result<(), RunError> {
-    // The same checks as `simulate` whenever the map simulates.
+/// The scenario and both axes of a map, checked (as `simulate` checks
+/// whenever the map simulates) before anything is written.
+pub fn prepare(a: &MapArgs) -> Result<(Scenario, Axis, Axis), RunError> {
     let sc = if a.transient || a.duration.is_some() {
         resolve_run(&a.scenario, a.duration)?
     } else {
@@ -285,6 +286,12 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
         ))
         .into());
     }
+    Ok((sc, x, y))
+}
+
+/// Run the command.
+pub fn run(a: MapArgs) -> Result<(), RunError> {
+    let (sc, x, y) = prepare(&a)?;
     let n = x.values.len() * y.values.len();
     let shard = a.shard.as_deref().map(Shard::parse).transpose()?;
     let dest = a.out.clone().unwrap_or_else(|| {

@@ -10,5 +10,6 @@ pub mod plot;
 pub mod reproduce;
 pub mod scenario;
 pub mod simulate;
+pub mod slurm;
 pub mod stability;
 pub mod sweep;

@@ -1,0 +1,267 @@
+//! `squeal slurm map … --tasks N [--partition P] [--time T]
+//! [--cpus-per-task C] [--jobs DIR] [--submit]`: a SLURM job array that
+//! computes a map in N shards, and a merge job that depends on it.
+//!
+//! Writes into the jobs folder (default `OUT-slurm`):
+//! - `array.sh`: `#SBATCH --array=0-(N-1)`; task K runs `squeal map …
+//!   --shard K/N --out JOBS/shard-K/map` with `RAYON_NUM_THREADS` set to
+//!   `SLURM_CPUS_PER_TASK`; its log is `JOBS/shard-K.log`. Each shard has a
+//!   parent folder of its own: staging removes leftovers of dead processes
+//!   by PID in the parent folder, and PIDs of other nodes mean nothing here;
+//! - `merge.sh`: `squeal merge JOBS/shard-{0..N-1}/map --out OUT`, log
+//!   `JOBS/merge.log`.
+//!
+//! With `--submit` it runs `sbatch --parsable array.sh`, then `sbatch
+//! --parsable --dependency=afterok:ID merge.sh`, and prints both job ids;
+//! without, it prints those two commands. Task K alone is rerun with
+//! `sbatch --array=K JOBS/array.sh` (then `sbatch JOBS/merge.sh`).
+
+use crate::commands::map::{prepare, MapArgs};
+use crate::run::{RunError, Staging};
+use clap::{Args, Subcommand};
+use squeal_study::scenario::InputError;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// What `squeal slurm` prepares.
+#[derive(Subcommand, Debug)]
+pub enum SlurmCmd {
+    /// A stability map as a job array of shards and a dependent merge job.
+    Map(SlurmMapArgs),
+}
+
+/// Arguments of `squeal slurm map`: those of `map` and the job's.
+#[derive(Args, Debug)]
+pub struct SlurmMapArgs {
+    #[command(flatten)]
+    map: MapArgs,
+    /// Number of array tasks (shards).
+    #[arg(long)]
+    tasks: usize,
+    /// SLURM partition (default: the cluster's default).
+    #[arg(long)]
+    partition: Option<String>,
+    /// Time limit of each task, in SLURM's format (e.g. 2:00:00).
+    #[arg(long)]
+    time: Option<String>,
+    /// CPUs of each task; squeal's threads follow SLURM_CPUS_PER_TASK.
+    #[arg(long)]
+    cpus_per_task: Option<usize>,
+    /// Folder for the scripts, the shards and the logs (default: OUT-slurm).
+    #[arg(long)]
+    jobs: Option<PathBuf>,
+    /// Submit both jobs with sbatch and print their ids.
+    #[arg(long)]
+    submit: bool,
+}
+
+/// `s` quoted for a POSIX shell.
+fn sh(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./=:,+@%".contains(c))
+    {
+        return s.to_string();
+    }
+    format!("'{}'", s.replace('\'', "'\\''"))
+}
+
+fn abs(p: &Path) -> Result<PathBuf, RunError> {
+    if p.is_absolute() {
+        return Ok(p.to_path_buf());
+    }
+    let cwd = std::env::current_dir()
+        .map_err(|e| RunError::Io(format!("cannot read the current folder: {e}")))?;
+    Ok(cwd.join(p))
+}
+
+/// A value for an `#SBATCH` line: one word.
+fn word(flag: &str, v: &Option<String>) -> Result<(), RunError> {
+    match v {
+        Some(s) if s.is_empty() || s.chars().any(|c| c.is_whitespace() || c.is_control()) => {
+            Err(InputError(format!("{flag} {s:?}: must be one word without spaces")).into())
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The `squeal map …` arguments that fix the study (not --out, --shard).
+fn map_args(a: &MapArgs) -> Vec<String> {
+    let mut v = vec!["map".to_string(), a.scenario.scenario.clone()];
+    for s in &a.scenario.sets {
+        v.extend(["--set".into(), s.clone()]);
+    }
+    v.extend(["--x".into(), a.x.clone(), "--y".into(), a.y.clone()]);
+    if a.log_x {
+        v.push("--log-x".into());
+    }
+    if a.log_y {
+        v.push("--log-y".into());
+    }
+    if a.transient {
+        v.push("--transient".into());
+    }
+    if let Some(d) = a.duration {
+        v.extend(["--duration".into(), format!("{d}")]);
+    }
+    v
+}
+
+fn sbatch(args: &[&str]) -> Result<String, RunError> {
+    let out = Command::new("sbatch")
+        .args(args)
+        .output()
+        .map_err(|e| RunError::Io(format!("cannot run sbatch: {e}")))?;
+    if !out.status.success() {
+        return Err(RunError::Io(format!(
+            "sbatch {} failed: {}",
+            args.join(" "),
+            String::from_utf8_lossy(&out.stderr).trim()
+        )));
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    // --parsable prints `ID` or `ID;CLUSTER`.
+    let id = text.trim().split(';').next().unwrap_or("").to_string();
+    if id.is_empty() || !id.chars().all(|c| c.is_ascii_digit()) {
+        return Err(RunError::Io(format!(
+            "sbatch printed no job id: {}",
+            text.trim()
+        )));
+    }
+    Ok(id)
+}
+
+/// Run the command.
+pub fn run(cmd: SlurmCmd) -> Result<(), RunError> {
+    let SlurmCmd::Map(a) = cmd;
+    if a.map.shard.is_some() {
+        return Err(InputError(
+            "--shard: not with `squeal slurm map` (each array task computes its own shard)".into(),
+        )
+        .into());
+    }
+    if a.tasks == 0 {
+        return Err(InputError("--tasks 0: need at least 1 task".into()).into());
+    }
+    if a.cpus_per_task == Some(0) {
+        return Err(InputError("--cpus-per-task 0: need at least 1 CPU".into()).into());
+    }
+    word("--partition", &a.partition)?;
+    word("--time", &a.time)?;
+    let (sc, x, y) = prepare(&a.map)?;
+    let points = x.values.len() * y.values.len();
+    let out = abs(&a
+        .map
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-map", sc.name))))?;
+    let jobs = abs(&a.jobs.clone().unwrap_or_else(|| {
+        let mut s = out.clone().into_os_string();
+        s.push("-slurm");
+        PathBuf::from(s)
+    }))?;
+    let flag = if a.jobs.is_some() {
+        "--jobs"
+    } else {
+        "jobs folder (default --jobs)"
+    };
+    let stage = Staging::new_as(flag, &jobs)?;
+    let exe = std::env::current_exe()
+        .map_err(|e| RunError::Io(format!("cannot find the squeal executable: {e}")))?;
+    let cwd = std::env::current_dir()
+        .map_err(|e| RunError::Io(format!("cannot read the current folder: {e}")))?;
+    let p = |p: &Path| sh(&p.to_string_lossy());
+    let n = a.tasks;
+    let mut head = String::from("#!/bin/bash\n");
+    let mut common = format!("#SBATCH --chdir={}\n", p(&cwd));
+    if let Some(part) = &a.partition {
+        common.push_str(&format!("#SBATCH --partition={part}\n"));
+    }
+    if let Some(t) = &a.time {
+        common.push_str(&format!("#SBATCH --time={t}\n"));
+    }
+    head.push_str(&format!(
+        "# squeal {}: {} map of {points} points in {n} shards\n",
+        env!("CARGO_PKG_VERSION"),
+        sc.name
+    ));
+    let study: Vec<String> = map_args(&a.map).iter().map(|s| sh(s)).collect();
+    let mut array = head.clone();
+    array.push_str(&format!(
+        "#SBATCH --job-name=squeal-map\n#SBATCH --array=0-{}\n",
+        n - 1
+    ));
+    if let Some(c) = a.cpus_per_task {
+        array.push_str(&format!("#SBATCH --cpus-per-task={c}\n"));
+    }
+    array.push_str(&format!(
+        "#SBATCH --output={}\n{common}",
+        p(&jobs.join("shard-%a.log"))
+    ));
+    array.push_str(&format!(
+        "set -euo pipefail\n# squeal's threads: the task's CPUs\nexport RAYON_NUM_THREADS=\"${{SLURM_CPUS_PER_TASK:-1}}\"\n\
+         K=\"$SLURM_ARRAY_TASK_ID\"\n\
+         exec {} {} --shard \"$K/{n}\" --out {}/shard-\"$K\"/map\n",
+        p(&exe),
+        study.join(" "),
+        p(&jobs)
+    ));
+    let mut merge = head;
+    merge.push_str(&format!(
+        "#SBATCH --job-name=squeal-merge\n#SBATCH --output={}\n{common}",
+        p(&jobs.join("merge.log"))
+    ));
+    merge.push_str(&format!(
+        "set -euo pipefail\nexec {} merge {}/shard-{{0..{}}}/map --out {}\n",
+        p(&exe),
+        p(&jobs),
+        n - 1,
+        p(&out)
+    ));
+    for (name, text) in [("array.sh", &array), ("merge.sh", &merge)] {
+        let path = stage.path(name);
+        std::fs::write(&path, text)
+            .map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))?;
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let _ = std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o755));
+        }
+    }
+    let jobs = stage.commit()?;
+    let (arr, mer) = (jobs.join("array.sh"), jobs.join("merge.sh"));
+    crate::outln!(
+        "{}: {points} points in {n} array tasks; scripts: {} and {}",
+        sc.name,
+        arr.display(),
+        mer.display()
+    );
+    if !a.submit {
+        crate::outln!(
+            "submit: ARRAY=$(sbatch --parsable {}) && sbatch --dependency=afterok:$ARRAY {}",
+            p(&arr),
+            p(&mer)
+        );
+        crate::outln!("rerun task K alone: sbatch --array=K {}", p(&arr));
+        return Ok(());
+    }
+    let id = sbatch(&["--parsable", &arr.to_string_lossy()])?;
+    let dep = format!("--dependency=afterok:{id}");
+    let mid = sbatch(&["--parsable", &dep, &mer.to_string_lossy()])?;
+    crate::outln!("submitted: array job {id}, merge job {mid} (after the array succeeds)");
+    crate::outln!("merged map: {}", out.display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shell_quoting_keeps_words_whole() {
+        assert_eq!(sh("V=0.5:20:5"), "V=0.5:20:5");
+        assert_eq!(sh("my file"), "'my file'");
+        assert_eq!(sh("it's"), "'it'\\''s'");
+        assert_eq!(sh(""), "''");
+    }
+}
