@@ -302,3 +302,22 @@ fn slurm_refuses_bad_job_settings() {
         assert!(!d.path().join("merged-slurm").exists());
     }
 }
+
+#[test]
+fn a_shard_with_json_prints_json_only() {
+    let d = tempfile::tempdir().unwrap();
+    let out = squeal(
+        d.path(),
+        &with(&LINEAR, &["--shard", "2/7", "--out", "s", "--json"]),
+    );
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON only");
+    // Points 2, 9, 16 of 20.
+    assert_eq!(
+        (j["shard"].as_u64(), j["points"].as_u64()),
+        (Some(2), Some(3))
+    );
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("s/shard.json")).unwrap())
+            .unwrap();
+    assert_eq!((m["k"].as_u64(), m["n"].as_u64()), (Some(2), Some(7)));
+}

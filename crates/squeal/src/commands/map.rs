@@ -344,14 +344,22 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
             trans.as_deref(),
         )?;
         let dest = stage.commit()?;
-        crate::outln!(
-            "{}: shard {}/{} — {} of {n} points; output: {} (shard.json, part.csv); gather with `squeal merge`",
-            sc.name,
-            s.k,
-            s.n,
-            points.len(),
-            dest.display()
-        );
+        if a.json {
+            let doc = json!({ "shard": s.k, "shards": s.n, "points": points.len(), "grid_points": n, "out": dest });
+            crate::outln!(
+                "{}",
+                serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
+            );
+        } else {
+            crate::outln!(
+                "{}: shard {}/{} — {} of {n} points; output: {} (shard.json, part.csv); gather with `squeal merge`",
+                sc.name,
+                s.k,
+                s.n,
+                points.len(),
+                dest.display()
+            );
+        }
         return Ok(());
     }
     let disagree = write_map(&stage, &labels, &x, &y, &lin, trans.as_deref())?;
