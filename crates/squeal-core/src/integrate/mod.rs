@@ -64,6 +64,9 @@ impl Default for SolverOptions {
     }
 }
 
+/// PI stabilisation of the step-size controller (0 = the elementary controller).
+const STEP_BETA: f64 = 0.04;
+
 /// Most mode changes in a row at one instant before it counts as chatter.
 const SETTLE_LIMIT: usize = 16;
 
@@ -219,7 +222,11 @@ pub struct Solver<'m, M: System<N> + ?Sized, const N: usize> {
     modes: Modes,
     h: f64,
     last_rejected: bool,
-    err_old: f64,
+    /// `β`-th power of the last accepted error (at least 1e-4) for the PI
+    /// controller, computed at acceptance (off the critical path), so
+    /// that only one `powf` lies on the path from a step's error to the next
+    /// step size.
+    err_old_pow: f64,
     k: [[f64; N]; 16],
     /// Dense output of the last segment: y_old and F0..F6.
     y_old: [f64; N],
@@ -304,7 +311,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             modes,
             h: 0.0,
             last_rejected: false,
-            err_old: 1e-4,
+            err_old_pow: 1e-4f64.powf(STEP_BETA),
             k: [[0.0; N]; 16],
             y_old: z0,
             dense: [[0.0; N]; 7],
@@ -507,49 +514,39 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
         (100.0 * h0).min(h1).min(self.opts.h_max)
     }
 
-    /// `base + h·Σ_j row[j]·k[j]` over the first `upto` stages, skipping the
-    /// tableau's zeros; the state index is innermost so the loop vectorises.
+    /// Stage `S`: its state `z + h·Σ_j a[S][j]·k[j]` from the earlier
+    /// stages, and its slope, written straight into `k[S]`.
     #[inline(always)]
-    fn combine(&self, base: &[f64; N], row: &[f64], upto: usize, h: f64) -> [f64; N] {
-        let mut y = *base;
-        for j in 0..upto {
-            let a = h * row[j];
-            if a != 0.0 {
-                let kj = &self.k[j];
-                for i in 0..N {
-                    y[i] += a * kj[i];
-                }
-            }
-        }
-        y
-    }
-
-    /// Stage `s`: its state from the earlier stages, and its slope.
-    #[inline(always)]
-    fn stage(&mut self, s: usize, t: f64, z: &[f64; N], mode: Modes, h: f64) {
-        let y = self.combine(z, &A[s], s, h);
-        let mut ks = [0.0; N];
-        self.rhs(t + C[s] * h, mode, &y, &mut ks);
-        self.k[s] = ks;
+    fn stage<const S: usize>(&mut self, t: f64, z: &[f64; N], modes: &Modes, h: f64) {
+        let y = combine::<N, S>(&self.k, z, &A[S], h);
+        self.stats.rhs_evals += 1;
+        self.model.field(t + C[S] * h, modes, &y, &mut self.k[S]);
     }
 
     /// One RK step of size h from the current state; fills `k[0..13]`,
     /// returns the new state and the error norm.
     #[inline]
     fn rk_step(&mut self, h: f64) -> ([f64; N], f64) {
-        let (t, z, mode) = (self.t, self.z, self.modes);
+        let (t, z, modes) = (self.t, self.z, self.modes);
         self.k[0] = self.f;
-        for s in 1..12 {
-            self.stage(s, t, &z, mode, h);
-        }
-        let z_new = self.combine(&z, &B, 12, h);
-        let mut f_new = [0.0; N];
-        self.rhs(t + h, mode, &z_new, &mut f_new);
-        self.k[12] = f_new;
+        self.stage::<1>(t, &z, &modes, h);
+        self.stage::<2>(t, &z, &modes, h);
+        self.stage::<3>(t, &z, &modes, h);
+        self.stage::<4>(t, &z, &modes, h);
+        self.stage::<5>(t, &z, &modes, h);
+        self.stage::<6>(t, &z, &modes, h);
+        self.stage::<7>(t, &z, &modes, h);
+        self.stage::<8>(t, &z, &modes, h);
+        self.stage::<9>(t, &z, &modes, h);
+        self.stage::<10>(t, &z, &modes, h);
+        self.stage::<11>(t, &z, &modes, h);
+        let z_new = combine::<N, 12>(&self.k, &z, &B, h);
+        self.stats.rhs_evals += 1;
+        self.model.field(t + h, &modes, &z_new, &mut self.k[12]);
         // Error estimate (Hairer's DOP853: 5th- and 3rd-order embedded errors).
         let zero = [0.0; N];
-        let e5 = self.combine(&zero, &E5, 13, 1.0);
-        let e3 = self.combine(&zero, &E3, 13, 1.0);
+        let e5 = combine::<N, 13>(&self.k, &zero, &E5, 1.0);
+        let e3 = combine::<N, 13>(&self.k, &zero, &E3, 1.0);
         let mut err5 = 0.0;
         let mut err3 = 0.0;
         for i in 0..N {
@@ -568,14 +565,15 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
     /// Dense output coefficients of the accepted step (three more stages).
     #[inline]
     fn build_dense(&mut self, h: f64, z_new: &[f64; N]) {
-        let (t, z, mode) = (self.t, self.z, self.modes);
-        for s in 13..16 {
-            self.stage(s, t, &z, mode, h);
-        }
+        let (t, z, modes) = (self.t, self.z, self.modes);
+        self.stage::<13>(t, &z, &modes, h);
+        self.stage::<14>(t, &z, &modes, h);
+        self.stage::<15>(t, &z, &modes, h);
         let zero = [0.0; N];
-        for r in 0..4 {
-            self.dense[3 + r] = self.combine(&zero, &D[r], 16, h);
-        }
+        self.dense[3] = combine::<N, 16>(&self.k, &zero, &D[0], h);
+        self.dense[4] = combine::<N, 16>(&self.k, &zero, &D[1], h);
+        self.dense[5] = combine::<N, 16>(&self.k, &zero, &D[2], h);
+        self.dense[6] = combine::<N, 16>(&self.k, &zero, &D[3], h);
         for i in 0..N {
             let dy = z_new[i] - z[i];
             let f_old = self.k[0][i];
@@ -619,9 +617,10 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
         out
     }
 
-    /// Power-basis coefficients in θ of the guard `c·y(θ) + d` on the step.
+    /// The guard `c·y(θ) + d` on the step in the dense output's own nested
+    /// form: its value `g0` at θ = 0 and the projections `g_r = c·F_r`.
     #[inline]
-    fn guard_poly(&self, c: &[f64; N], d: f64) -> [f64; 8] {
+    fn guard_dense(&self, c: &[f64; N], d: f64) -> (f64, [f64; 7]) {
         let mut g = [0.0; 7];
         let mut g0 = d;
         for i in 0..N {
@@ -630,24 +629,14 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 g[r] += c[i] * self.dense[r][i];
             }
         }
-        // y(θ) = y_old + θ(F0 + (1−θ)(F1 + θ(F2 + (1−θ)(F3 + θ(F4 + (1−θ)(F5 + θ F6)))))):
-        // from the inside out, add g_r then multiply by θ (r even) or 1 − θ (r odd).
-        let mut p = [0.0; 8];
-        for r in (0..7).rev() {
-            p[0] += g[r];
-            let mut q = [0.0; 8];
-            for i in 0..7 {
-                if r % 2 == 0 {
-                    q[i + 1] = p[i];
-                } else {
-                    q[i] += p[i];
-                    q[i + 1] -= p[i];
-                }
-            }
-            p = q;
-        }
-        p[0] += g0;
-        p
+        (g0, g)
+    }
+
+    /// Power-basis coefficients in θ of the guard `c·y(θ) + d` on the step.
+    #[inline]
+    fn guard_poly(&self, c: &[f64; N], d: f64) -> [f64; 8] {
+        let (g0, g) = self.guard_dense(c, d);
+        power_basis(g0, &g)
     }
 
     /// Advance by one accepted step, cut at the first event if one occurs in it.
@@ -672,7 +661,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
         const SAFE: f64 = 0.9;
         const FAC_MIN: f64 = 1.0 / 3.0; // step may shrink to a third…
         const FAC_MAX: f64 = 6.0; // …or grow sixfold
-        const BETA: f64 = 0.04; // PI stabilisation (0 = the elementary controller)
+        const BETA: f64 = STEP_BETA;
         let (z_new, h, first) = 'attempt: loop {
             let (z_new, h) = loop {
                 let mut h = self.h.min(self.opts.h_max);
@@ -702,9 +691,8 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 // oscillatory problem, which otherwise rejects one step in five.
                 let fac11 = err.powf(1.0 / 8.0 - 0.75 * BETA);
                 if err <= 1.0 {
-                    let fac = (fac11 / self.err_old.powf(BETA) / SAFE)
-                        .clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-                    self.err_old = err.max(1e-4);
+                    let fac = (fac11 / self.err_old_pow / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+                    self.err_old_pow = err.max(1e-4).powf(BETA);
                     let mut h_new = h / fac;
                     if self.last_rejected {
                         h_new = h_new.min(h);
@@ -728,8 +716,12 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             for gi in 0..self.guards.len() {
                 let g = self.guards.as_slice()[gi];
                 let found = if g.affine {
-                    let p = self.guard_poly(&g.c, g.d);
-                    roots::first_upcrossing(&p, tol)
+                    let (g0, gr) = self.guard_dense(&g.c, g.d);
+                    if clearly_negative(g0, &gr) {
+                        None
+                    } else {
+                        roots::first_upcrossing(&power_basis(g0, &gr), tol)
+                    }
                 } else {
                     let b = *bounds.get_or_insert_with(|| self.step_bounds());
                     match self.lipschitz_upcrossing(&g, h, &b, tol) {
@@ -900,6 +892,74 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
         }
         Err(())
     }
+}
+
+/// Power-basis coefficients of the dense output's nested form
+/// `g0 + θ(g_0 + (1−θ)(g_1 + θ(g_2 + (1−θ)(g_3 + θ(g_4 + (1−θ)(g_5 + θ g_6))))))`.
+#[inline]
+fn power_basis(g0: f64, g: &[f64; 7]) -> [f64; 8] {
+    // From the inside out, add g_r then multiply by θ (r even) or 1 − θ (r odd).
+    let mut p = [0.0; 8];
+    for r in (0..7).rev() {
+        p[0] += g[r];
+        let mut q = [0.0; 8];
+        for i in 0..7 {
+            if r % 2 == 0 {
+                q[i + 1] = p[i];
+            } else {
+                q[i] += p[i];
+                q[i + 1] -= p[i];
+            }
+        }
+        p = q;
+    }
+    p[0] += g0;
+    p
+}
+
+/// Whether a guard in the nested form of [`power_basis`] is negative on the
+/// whole step with a margin far above round-off, so that the root search
+/// would find no crossing: θ and 1 − θ lie in [0, 1], so every Bernstein
+/// coefficient of `g − g0` on [0, 1] is at most `Σ|g_r|` in magnitude (the
+/// Bernstein coefficients of a product are convex combinations of products
+/// of the factors' coefficients). The 1e-9 relative margin covers the
+/// round-off of the power and Bernstein conversions (≈ 1e-12 relative), so
+/// [`roots::first_upcrossing`] would see only negative coefficients and
+/// return `None`: the answer is the same, without either conversion.
+#[inline]
+fn clearly_negative(g0: f64, g: &[f64; 7]) -> bool {
+    let s: f64 = g.iter().map(|x| x.abs()).sum();
+    g0 < 0.0 && s + 1e-9 * (s - g0) < -g0
+}
+
+/// `base + Σ_{j<J} (h·row[j])·k[j]`, the stage combination of a tableau row.
+/// `row` is a constant of [`tableau`] and `J` a constant, so once inlined the
+/// terms are written out one by one (no loop) and the tableau's zeros vanish
+/// at compile time (the test is on the constant; `h·row[j]` is never zero
+/// for a non-zero entry). The state index is innermost, so each term is a
+/// few vector instructions. The terms are added in the order of `j`: the
+/// same sums, bit for bit, as a loop.
+#[inline(always)]
+fn combine<const N: usize, const J: usize>(
+    k: &[[f64; N]; 16],
+    base: &[f64; N],
+    row: &[f64],
+    h: f64,
+) -> [f64; N] {
+    let mut y = *base;
+    macro_rules! terms {
+        ($($j:literal)*) => {$(
+            if $j < J && row[$j] != 0.0 {
+                let a = h * row[$j];
+                let kj = &k[$j];
+                for i in 0..N {
+                    y[i] += a * kj[i];
+                }
+            }
+        )*};
+    }
+    terms!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
+    y
 }
 
 /// Ranges of the states and of their θ-derivatives over one step.

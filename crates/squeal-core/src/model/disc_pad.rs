@@ -331,7 +331,7 @@ impl Model<8> for DiscPad {
     }
 
     /// MODEL.md §3 (slip), §4 (stick), and free flight without contact.
-    #[inline]
+    #[inline(always)]
     fn rhs(&self, t: f64, mode: Mode, z: &[f64; 8], dz: &mut [f64; 8]) {
         let p = &self.p;
         let (f_y, f_t, a_stick) = match mode {

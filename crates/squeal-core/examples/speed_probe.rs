@@ -1,0 +1,108 @@
+//! Fingerprints and a timing window for the integrator (BENCHMARKS.md, issue 16).
+//!
+//! `cargo run --release -p squeal-core --example speed_probe -- fingerprint`
+//! prints, per scenario, the step counts, events and a hash of every sample
+//! and event bit, so that a change meant to keep the method bit-for-bit can
+//! be checked. `… -- window` runs only the default disc–pad's 0.3 s
+//! event-free window from rest (the run measured under callgrind).
+
+use squeal_core::model::lumped::{disc_pad_spec, Fixed};
+use squeal_core::model::{EventKind, Mode};
+use squeal_core::sink::Discard;
+use squeal_core::{
+    simulate, Belt, DiscPad, Flow, FrictionLaw, Hoffmann, Lumped, Sink, SolverOptions, System,
+};
+
+/// FNV-1a over the bits of every sample and event.
+struct Hash(u64, u64);
+
+impl Hash {
+    fn eat(&mut self, x: f64) {
+        for b in x.to_bits().to_le_bytes() {
+            self.0 = (self.0 ^ b as u64).wrapping_mul(0x100000001b3);
+        }
+        self.1 += 1;
+    }
+}
+
+impl<const N: usize> Sink<N> for Hash {
+    fn sample(&mut self, t: f64, z: &[f64; N], mode: Mode) -> Flow {
+        self.eat(t);
+        self.eat(mode.index() as f64);
+        z.iter().for_each(|&x| self.eat(x));
+        Flow::Continue
+    }
+    fn event(&mut self, t: f64, kind: EventKind, z: &[f64; N], mode: Mode) {
+        self.eat(t);
+        self.eat(kind.index() as f64 + 10.0 * mode.index() as f64);
+        z.iter().for_each(|&x| self.eat(x));
+    }
+}
+
+fn run<M: System<N>, const N: usize>(name: &str, m: &M, z0: [f64; N], t_end: f64, rate: f64) {
+    let mut h = Hash(0xcbf29ce484222325, 0);
+    let info = simulate(m, 0.0, z0, t_end, rate, SolverOptions::default(), &mut h).unwrap();
+    let s = info.stats;
+    println!(
+        "{name}: accepted {} rejected {} rhs {} events {:?} hash {:016x} ({} numbers)",
+        s.accepted, s.rejected, s.rhs_evals, s.events, h.0, h.1
+    );
+}
+
+fn main() {
+    let what = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "fingerprint".into());
+    let disc = DiscPad::default();
+    if what == "window" {
+        let reps: usize = std::env::args()
+            .nth(2)
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(1);
+        for _ in 0..reps {
+            let opts = SolverOptions::default();
+            let info = simulate(&disc, 0.0, [0.0; 8], 0.3, 200_000.0, opts, &mut Discard).unwrap();
+            println!("window: {:?}", info.stats);
+        }
+        return;
+    }
+    run("disc-pad 0.3 s window", &disc, [0.0; 8], 0.3, 200_000.0);
+    run("disc-pad 1 s", &disc, [0.0; 8], 1.0, 20_000.0);
+    let mut alpha = disc;
+    alpha.p.alpha = 2.0;
+    alpha.p.t_ramp = 0.01;
+    run("disc-pad alpha ramp 0.5 s", &alpha, [0.0; 8], 0.5, 20_000.0);
+    let mut strib = disc;
+    strib.friction = FrictionLaw::by_name("stribeck").unwrap();
+    run("disc-pad stribeck 0.5 s", &strib, [0.0; 8], 0.5, 20_000.0);
+    let belt = Belt {
+        friction: FrictionLaw::Coulomb {
+            mu_s: 0.4,
+            mu_k: 0.3,
+        },
+        ..Belt::default()
+    };
+    run("belt coulomb 10 s", &belt, [0.0; 2], 10.0, 1000.0);
+    run(
+        "belt default 10 s",
+        &Belt::default(),
+        [0.0; 2],
+        10.0,
+        1000.0,
+    );
+    let hoff = Hoffmann::default();
+    let z0 = {
+        let mut z = [0.0; 4];
+        z[0] = 1e-6;
+        z
+    };
+    run("hoffmann 0.5 s", &hoff, z0, 0.5, 10_000.0);
+    let lumped = Lumped::build(&disc_pad_spec(&disc)).unwrap();
+    run(
+        "lumped disc-pad 0.5 s",
+        &Fixed::<8>(&lumped),
+        [0.0; 8],
+        0.5,
+        20_000.0,
+    );
+}
