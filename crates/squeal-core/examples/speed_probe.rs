@@ -6,6 +6,7 @@
 //! be checked. `… -- window` runs only the default disc–pad's 0.3 s
 //! event-free window from rest (the run measured under callgrind).
 
+use squeal_core::integrate::ensemble::{simulate_ensemble, Job};
 use squeal_core::model::lumped::{disc_pad_spec, Fixed};
 use squeal_core::model::{EventKind, Mode};
 use squeal_core::sink::Discard;
@@ -49,6 +50,24 @@ fn run<M: System<N>, const N: usize>(name: &str, m: &M, z0: [f64; N], t_end: f64
     );
 }
 
+fn lanes<const L: usize>(models: &[DiscPad]) -> u64 {
+    let mut jobs: Vec<Job<'_, DiscPad, Discard, 8>> = models
+        .iter()
+        .map(|m| Job {
+            model: m,
+            t0: 0.0,
+            z0: [0.0; 8],
+            t_end: 0.3,
+            opts: SolverOptions::default(),
+            sink: Discard,
+        })
+        .collect();
+    simulate_ensemble::<DiscPad, Discard, 8, L>(&mut jobs, 200_000.0)
+        .iter()
+        .map(|r| r.as_ref().unwrap().stats.accepted)
+        .sum()
+}
+
 fn main() {
     let what = std::env::args()
         .nth(1)
@@ -64,6 +83,40 @@ fn main() {
             let info = simulate(&disc, 0.0, [0.0; 8], 0.3, 200_000.0, opts, &mut Discard).unwrap();
             println!("window: {:?}", info.stats);
         }
+        return;
+    }
+    if what == "lanes" {
+        // `lanes L`: 16 disc–pads (V from 0.8 to 1.55 m/s), 0.3 s from rest at
+        // 200 kHz, L at a time (L = 1: `simulate` one after the other).
+        let l: usize = std::env::args()
+            .nth(2)
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(1);
+        let models: Vec<DiscPad> = (0..16)
+            .map(|k| {
+                let mut m = disc;
+                m.p.V = 0.8 + 0.05 * k as f64;
+                m
+            })
+            .collect();
+        let t = std::time::Instant::now();
+        let steps: u64 = match l {
+            1 => models
+                .iter()
+                .map(|m| {
+                    let o = SolverOptions::default();
+                    let i = simulate(m, 0.0, [0.0; 8], 0.3, 200_000.0, o, &mut Discard).unwrap();
+                    i.stats.accepted
+                })
+                .sum(),
+            4 => lanes::<4>(&models),
+            8 => lanes::<8>(&models),
+            _ => panic!("L = 1, 4 or 8"),
+        };
+        println!(
+            "L = {l}: {steps} steps in {:.3} s",
+            t.elapsed().as_secs_f64()
+        );
         return;
     }
     run("disc-pad 0.3 s window", &disc, [0.0; 8], 0.3, 200_000.0);

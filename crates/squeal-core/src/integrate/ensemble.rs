@@ -1,0 +1,407 @@
+//! Several trajectories at once on one core: `L` lanes, each its own run
+//! (model, start, end, step size, modes, events, sink), stepped together.
+//!
+//! Every lane goes through exactly the code path of [`super::simulate`]
+//! (the same step-size control, event search, transitions and sink feeding,
+//! through the same [`Solver`] methods); only the Runge–Kutta arithmetic of
+//! an attempt is done for all lanes together, in a structure-of-arrays
+//! layout (`[stage][state][lane]`) whose innermost loop runs across lanes.
+//! Each lane's numbers go through the same operations in the same order as
+//! in a run of its own, so the ensemble's results are bit-for-bit those of
+//! one-at-a-time runs. What it gains: the lanes' right-hand sides are
+//! independent, so the processor overlaps their latencies, which a single
+//! trajectory's serial chain of stages cannot do.
+//!
+//! A lane whose run ends (finished, stopped by its sink, or failed) takes
+//! the next job at once, so a sweep of many short runs keeps all lanes busy.
+
+use super::tableau::{A, B, C, D, E3, E5};
+use super::{check_rate, Feed, IntegrateError, RunInfo, Sink, Solver, SolverOptions};
+use crate::model::System;
+
+/// One run of an ensemble: what [`super::simulate`] takes, per lane.
+pub struct Job<'m, M: System<N> + ?Sized, S: Sink<N>, const N: usize> {
+    /// The model (each job may have its own parameters).
+    pub model: &'m M,
+    /// Start time (s).
+    pub t0: f64,
+    /// Start state.
+    pub z0: [f64; N],
+    /// End time (s).
+    pub t_end: f64,
+    /// Solver options (each job may have its own step budget).
+    pub opts: SolverOptions,
+    /// Where the samples and events go.
+    pub sink: S,
+}
+
+/// A lane at work: its job's index, solver, feed, and the step in progress.
+struct Lane<'m, M: System<N> + ?Sized, const N: usize> {
+    job: usize,
+    solver: Solver<'m, M, N>,
+    feed: Feed,
+    /// `t_stop` of the step in progress, if one is.
+    step: Option<f64>,
+    /// Size of the attempt in progress, and whether it is clipped to `t_stop`.
+    attempt: (f64, bool),
+}
+
+/// Integrate every job as [`super::simulate`] would, `L` at a time, feeding
+/// samples at `t0 + k/sample_rate` and events into each job's sink. Returns
+/// each job's result, in order; a job that fails does not stop the others.
+pub fn simulate_ensemble<'m, M, S, const N: usize, const L: usize>(
+    jobs: &mut [Job<'m, M, S, N>],
+    sample_rate: f64,
+) -> Vec<Result<RunInfo, IntegrateError>>
+where
+    M: System<N> + ?Sized,
+    S: Sink<N>,
+{
+    let mut results: Vec<Option<Result<RunInfo, IntegrateError>>> =
+        (0..jobs.len()).map(|_| None).collect();
+    if let Err(e) = check_rate(sample_rate) {
+        return jobs.iter().map(|_| Err(e.clone())).collect();
+    }
+    let mut lanes: [Option<Lane<'m, M, N>>; L] = std::array::from_fn(|_| None);
+    let mut next_job = 0;
+    let mut soa = Soa::<N, L>::new();
+    loop {
+        // Fill idle lanes, start their steps and size their attempts; a lane
+        // whose run ends here is emptied and filled again.
+        let mut active = [false; L];
+        for l in 0..L {
+            loop {
+                if lanes[l].is_none() {
+                    if next_job >= jobs.len() {
+                        break;
+                    }
+                    let j = next_job;
+                    next_job += 1;
+                    lanes[l] = start_lane(j, &mut jobs[j], sample_rate, &mut results);
+                    continue;
+                }
+                let lane = lanes[l].as_mut().expect("filled above");
+                match prepare(lane) {
+                    Ok(true) => {
+                        active[l] = true;
+                        break;
+                    }
+                    Ok(false) => {
+                        let info = RunInfo {
+                            stats: *lane.solver.stats(),
+                            t_final: lane.solver.t(),
+                            stopped_early: false,
+                        };
+                        results[lane.job] = Some(Ok(info));
+                        lanes[l] = None;
+                    }
+                    Err(e) => {
+                        results[lane.job] = Some(Err(e));
+                        lanes[l] = None;
+                    }
+                }
+            }
+        }
+        if !active.contains(&true) {
+            break;
+        }
+        // One attempt of every active lane, together.
+        soa.attempt(&mut lanes, &active);
+        let mut accepted = [false; L];
+        for l in 0..L {
+            if !active[l] {
+                continue;
+            }
+            let lane = lanes[l].as_mut().expect("active");
+            let (h, hits_stop) = lane.attempt;
+            let (z_new, err) = soa.outcome(l, &lane.solver);
+            match lane.solver.judge(h, hits_stop, &z_new, err) {
+                Ok(ok) => accepted[l] = ok,
+                Err(e) => {
+                    results[lane.job] = Some(Err(e));
+                    lanes[l] = None;
+                }
+            }
+        }
+        if !accepted.contains(&true) {
+            continue;
+        }
+        soa.dense_stages(&mut lanes, &accepted);
+        for l in 0..L {
+            if !accepted[l] {
+                continue;
+            }
+            let lane = lanes[l].as_mut().expect("accepted");
+            let job = &mut jobs[lane.job];
+            let (h, _) = lane.attempt;
+            let t_stop = lane.step.expect("a step in progress");
+            let z_new = soa.z_new_of(l);
+            lane.solver.dense_low(h, &z_new);
+            match lane.solver.settle(h, t_stop, z_new) {
+                Ok(None) => {} // retried shorter
+                Ok(Some(seg)) => {
+                    lane.step = None;
+                    if let Some(info) = lane.feed.segment(&mut lane.solver, &seg, &mut job.sink) {
+                        results[lane.job] = Some(Ok(info));
+                        lanes[l] = None;
+                    }
+                }
+                Err(e) => {
+                    results[lane.job] = Some(Err(e));
+                    lanes[l] = None;
+                }
+            }
+        }
+    }
+    results
+        .into_iter()
+        .map(|r| r.expect("every job ran"))
+        .collect()
+}
+
+/// Start job `j` in a lane: `None` if it ended at once (its result is recorded).
+fn start_lane<'m, M, S, const N: usize>(
+    j: usize,
+    job: &mut Job<'m, M, S, N>,
+    sample_rate: f64,
+    results: &mut [Option<Result<RunInfo, IntegrateError>>],
+) -> Option<Lane<'m, M, N>>
+where
+    M: System<N> + ?Sized,
+    S: Sink<N>,
+{
+    let mut solver = match Solver::new(job.model, job.t0, job.z0, job.t_end, job.opts) {
+        Ok(s) => s,
+        Err(e) => {
+            results[j] = Some(Err(e));
+            return None;
+        }
+    };
+    let mut feed = Feed::new(job.t0, job.t_end, sample_rate);
+    if let Some(info) = feed.start(&mut solver, &mut job.sink) {
+        results[j] = Some(Ok(info));
+        return None;
+    }
+    Some(Lane {
+        job: j,
+        solver,
+        feed,
+        step: None,
+        attempt: (0.0, false),
+    })
+}
+
+/// Begin a step if none is in progress and size the lane's next attempt:
+/// `Ok(false)` once its run is at its end.
+fn prepare<M: System<N> + ?Sized, const N: usize>(
+    lane: &mut Lane<'_, M, N>,
+) -> Result<bool, IntegrateError> {
+    let t_stop = match lane.step {
+        Some(t) => t,
+        None => match lane.solver.begin_step()? {
+            Some(t) => t,
+            None => return Ok(false),
+        },
+    };
+    lane.step = Some(t_stop);
+    lane.attempt = lane.solver.attempt_size(t_stop)?;
+    Ok(true)
+}
+
+/// The Runge–Kutta arithmetic of `L` lanes, `[stage][state][lane]`.
+struct Soa<const N: usize, const L: usize> {
+    k: [[[f64; L]; N]; 16],
+    z: [[f64; L]; N],
+    z_new: [[f64; L]; N],
+    e5: [[f64; L]; N],
+    e3: [[f64; L]; N],
+    t: [f64; L],
+    h: [f64; L],
+}
+
+impl<const N: usize, const L: usize> Soa<N, L> {
+    fn new() -> Self {
+        Soa {
+            k: [[[0.0; L]; N]; 16],
+            z: [[0.0; L]; N],
+            z_new: [[0.0; L]; N],
+            e5: [[0.0; L]; N],
+            e3: [[0.0; L]; N],
+            t: [0.0; L],
+            h: [0.0; L],
+        }
+    }
+
+    /// Stage `S` of every lane in `mask`: its state from the earlier
+    /// stages (all lanes at once), its slope from the lane's own model.
+    #[inline(always)]
+    fn stage<M: System<N> + ?Sized, const S: usize>(
+        &mut self,
+        lanes: &mut [Option<Lane<'_, M, N>>; L],
+        mask: &[bool; L],
+    ) {
+        let y = combine_lanes::<N, L, S>(&self.k, &self.z, &A[S], &self.h);
+        self.slopes(lanes, mask, S, &y, C[S]);
+    }
+
+    /// `k[s] = f(t + c·h, y)` of every lane in `mask` (0 elsewhere).
+    #[inline(always)]
+    fn slopes<M: System<N> + ?Sized>(
+        &mut self,
+        lanes: &mut [Option<Lane<'_, M, N>>; L],
+        mask: &[bool; L],
+        s: usize,
+        y: &[[f64; L]; N],
+        c: f64,
+    ) {
+        for (l, lane) in lanes.iter_mut().enumerate() {
+            let mut out = [0.0; N];
+            if let (Some(lane), true) = (lane, mask[l]) {
+                let solver = &mut lane.solver;
+                let yl: [f64; N] = std::array::from_fn(|i| y[i][l]);
+                solver.stats.rhs_evals += 1;
+                let tc = if s == 12 {
+                    self.t[l] + self.h[l]
+                } else {
+                    self.t[l] + c * self.h[l]
+                };
+                solver.model.field(tc, &solver.modes, &yl, &mut out);
+            }
+            for i in 0..N {
+                self.k[s][i][l] = out[i];
+            }
+        }
+    }
+
+    /// One attempt of every active lane (its size is in the lane): stages
+    /// 1…12 as [`Solver::rk_step`] computes them, and the error estimates.
+    fn attempt<M: System<N> + ?Sized>(
+        &mut self,
+        lanes: &mut [Option<Lane<'_, M, N>>; L],
+        active: &[bool; L],
+    ) {
+        for l in 0..L {
+            let (t, h, z, f) = match &lanes[l] {
+                Some(lane) if active[l] => {
+                    (lane.solver.t, lane.attempt.0, lane.solver.z, lane.solver.f)
+                }
+                _ => (0.0, 0.0, [0.0; N], [0.0; N]),
+            };
+            self.t[l] = t;
+            self.h[l] = h;
+            for i in 0..N {
+                self.z[i][l] = z[i];
+                self.k[0][i][l] = f[i];
+            }
+        }
+        self.stage::<M, 1>(lanes, active);
+        self.stage::<M, 2>(lanes, active);
+        self.stage::<M, 3>(lanes, active);
+        self.stage::<M, 4>(lanes, active);
+        self.stage::<M, 5>(lanes, active);
+        self.stage::<M, 6>(lanes, active);
+        self.stage::<M, 7>(lanes, active);
+        self.stage::<M, 8>(lanes, active);
+        self.stage::<M, 9>(lanes, active);
+        self.stage::<M, 10>(lanes, active);
+        self.stage::<M, 11>(lanes, active);
+        let z_new = combine_lanes::<N, L, 12>(&self.k, &self.z, &B, &self.h);
+        self.slopes(lanes, active, 12, &z_new, 1.0);
+        self.z_new = z_new;
+        let zero = [[0.0; L]; N];
+        let one = [1.0; L];
+        self.e5 = combine_lanes::<N, L, 13>(&self.k, &zero, &E5, &one);
+        self.e3 = combine_lanes::<N, L, 13>(&self.k, &zero, &E3, &one);
+    }
+
+    /// Lane `l`'s new state and error norm; its slopes 0…12 go to its solver.
+    fn outcome<M: System<N> + ?Sized>(
+        &self,
+        l: usize,
+        solver: &Solver<'_, M, N>,
+    ) -> ([f64; N], f64) {
+        let col = |a: &[[f64; L]; N]| -> [f64; N] { std::array::from_fn(|i| a[i][l]) };
+        let z_new = col(&self.z_new);
+        let err = solver.error_norm(
+            self.h[l],
+            &col(&self.z),
+            &z_new,
+            &col(&self.e5),
+            &col(&self.e3),
+        );
+        (z_new, err)
+    }
+
+    /// Lane `l`'s new state.
+    fn z_new_of(&self, l: usize) -> [f64; N] {
+        std::array::from_fn(|i| self.z_new[i][l])
+    }
+
+    /// The dense output's three extra stages of the accepted lanes and its
+    /// high-order coefficients, copied into their solvers (with the slopes
+    /// at both ends of the step).
+    fn dense_stages<M: System<N> + ?Sized>(
+        &mut self,
+        lanes: &mut [Option<Lane<'_, M, N>>; L],
+        accepted: &[bool; L],
+    ) {
+        self.stage::<M, 13>(lanes, accepted);
+        self.stage::<M, 14>(lanes, accepted);
+        self.stage::<M, 15>(lanes, accepted);
+        let zero = [[0.0; L]; N];
+        let d: [[[f64; L]; N]; 4] = [
+            combine_lanes::<N, L, 16>(&self.k, &zero, &D[0], &self.h),
+            combine_lanes::<N, L, 16>(&self.k, &zero, &D[1], &self.h),
+            combine_lanes::<N, L, 16>(&self.k, &zero, &D[2], &self.h),
+            combine_lanes::<N, L, 16>(&self.k, &zero, &D[3], &self.h),
+        ];
+        for (l, lane) in lanes.iter_mut().enumerate() {
+            let (Some(lane), true) = (lane, accepted[l]) else {
+                continue;
+            };
+            let solver = &mut lane.solver;
+            for i in 0..N {
+                for r in 0..4 {
+                    solver.dense[3 + r][i] = d[r][i][l];
+                }
+                solver.k[0][i] = self.k[0][i][l];
+                solver.k[12][i] = self.k[12][i][l];
+            }
+        }
+    }
+}
+
+/// [`super::combine`] for `L` lanes at once: `base + Σ_{j<J} (h_l·row[j])·k[j]`
+/// lane by lane, the terms in the same order, so each lane's sums are bit
+/// for bit those of a single run. State by state, so that the lanes' partial
+/// sums stay in registers.
+#[inline(always)]
+fn combine_lanes<const N: usize, const L: usize, const J: usize>(
+    k: &[[[f64; L]; N]; 16],
+    base: &[[f64; L]; N],
+    row: &[f64],
+    h: &[f64; L],
+) -> [[f64; L]; N] {
+    let mut a = [[0.0; L]; 16];
+    for j in 0..J {
+        for l in 0..L {
+            a[j][l] = h[l] * row[j];
+        }
+    }
+    let mut y = *base;
+    for i in 0..N {
+        let mut yi = y[i];
+        macro_rules! terms {
+            ($($j:literal)*) => {$(
+                if $j < J && row[$j] != 0.0 {
+                    for l in 0..L {
+                        yi[l] += a[$j][l] * k[$j][i][l];
+                    }
+                }
+            )*};
+        }
+        terms!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
+        y[i] = yi;
+    }
+    y
+}
