@@ -50,7 +50,7 @@ fn run<M: System<N>, const N: usize>(name: &str, m: &M, z0: [f64; N], t_end: f64
     );
 }
 
-fn lanes<const L: usize>(models: &[DiscPad]) -> u64 {
+fn lanes(models: &[DiscPad]) -> u64 {
     let mut jobs: Vec<Job<'_, DiscPad, Discard, 8>> = models
         .iter()
         .map(|m| Job {
@@ -62,7 +62,7 @@ fn lanes<const L: usize>(models: &[DiscPad]) -> u64 {
             sink: Discard,
         })
         .collect();
-    simulate_ensemble::<DiscPad, Discard, 8, L>(&mut jobs, 200_000.0)
+    simulate_ensemble::<DiscPad, Discard, 8>(&mut jobs, 200_000.0)
         .iter()
         .map(|r| r.as_ref().unwrap().stats.accepted)
         .sum()
@@ -109,9 +109,8 @@ fn main() {
                     i.stats.accepted
                 })
                 .sum(),
-            4 => lanes::<4>(&models),
-            8 => lanes::<8>(&models),
-            _ => panic!("L = 1, 4 or 8"),
+            4 => lanes(&models),
+            _ => panic!("L = 1 or 4"),
         };
         println!(
             "L = {l}: {steps} steps in {:.3} s",

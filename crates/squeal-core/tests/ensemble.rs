@@ -41,7 +41,7 @@ struct Case<const N: usize> {
 
 /// Run `cases` on `models` one at a time and as an ensemble of `L` lanes;
 /// assert identical results. Returns the one-at-a-time results.
-fn same_as_single<M: System<N>, const N: usize, const L: usize>(
+fn same_as_single<M: System<N>, const N: usize>(
     models: &[M],
     cases: &[Case<N>],
     rate: f64,
@@ -72,7 +72,7 @@ fn same_as_single<M: System<N>, const N: usize, const L: usize>(
             },
         })
         .collect();
-    let together = simulate_ensemble::<M, Upto<N>, N, L>(&mut jobs, rate);
+    let together = simulate_ensemble::<M, Upto<N>, N>(&mut jobs, rate);
     assert_eq!(together.len(), single.len());
     for (k, ((one, many), job)) in single.iter().zip(&together).zip(&jobs).enumerate() {
         match (one, many) {
@@ -158,7 +158,7 @@ fn disc_pad_lanes_match_single_runs() {
     soft.p.k_py = 4.0e8;
     push(soft, kicked(1.8), 0.015, opts, usize::MAX);
 
-    let single = same_as_single::<DiscPad, 8, 4>(&models, &cases, 50_000.0);
+    let single = same_as_single::<DiscPad, 8>(&models, &cases, 50_000.0);
     // The cases are what they claim to be.
     let ok: Vec<_> = single.iter().filter_map(|r| r.as_ref().ok()).collect();
     assert!(
@@ -179,9 +179,8 @@ fn disc_pad_lanes_match_single_runs() {
         reversals > 10 && sticks > 0,
         "{reversals} reversals, {sticks} sticks"
     );
-    // Eight lanes and one lane give the same too.
-    same_as_single::<DiscPad, 8, 8>(&models, &cases, 50_000.0);
-    same_as_single::<DiscPad, 8, 1>(&models, &cases, 50_000.0);
+    // Fewer jobs than lanes.
+    same_as_single::<DiscPad, 8>(&models[..2], &cases[..2], 50_000.0);
 }
 
 /// The mass on a belt with Coulomb stick-slip (exact sticks and slips),
@@ -207,7 +206,7 @@ fn belt_lanes_match_single_runs() {
             limit: if k == 3 { 150 } else { usize::MAX },
         });
     }
-    let single = same_as_single::<Belt, 2, 4>(&models, &cases, 1000.0);
+    let single = same_as_single::<Belt, 2>(&models, &cases, 1000.0);
     let sticking = single
         .iter()
         .filter(|r| r.as_ref().unwrap().0.stats.event_count(EventKind::Stick) > 0)

@@ -18,6 +18,11 @@
 use super::tableau::{A, B, C, D, E3, E5};
 use super::{check_rate, Feed, IntegrateError, RunInfo, Sink, Solver, SolverOptions};
 use crate::model::System;
+use wide::f64x4;
+
+/// Lanes of an ensemble: one [`f64x4`] holds a number of each.
+pub const LANES: usize = 4;
+const L: usize = LANES;
 
 /// One run of an ensemble: what [`super::simulate`] takes, per lane.
 pub struct Job<'m, M: System<N> + ?Sized, S: Sink<N>, const N: usize> {
@@ -49,7 +54,7 @@ struct Lane<'m, M: System<N> + ?Sized, const N: usize> {
 /// Integrate every job as [`super::simulate`] would, `L` at a time, feeding
 /// samples at `t0 + k/sample_rate` and events into each job's sink. Returns
 /// each job's result, in order; a job that fails does not stop the others.
-pub fn simulate_ensemble<'m, M, S, const N: usize, const L: usize>(
+pub fn simulate_ensemble<'m, M, S, const N: usize>(
     jobs: &mut [Job<'m, M, S, N>],
     sample_rate: f64,
 ) -> Vec<Result<RunInfo, IntegrateError>>
@@ -64,7 +69,7 @@ where
     }
     let mut lanes: [Option<Lane<'m, M, N>>; L] = std::array::from_fn(|_| None);
     let mut next_job = 0;
-    let mut soa = Soa::<N, L>::new();
+    let mut soa = Soa::<N>::new();
     loop {
         // Fill idle lanes, start their steps and size their attempts; a lane
         // whose run ends here is emptied and filled again.
@@ -208,27 +213,35 @@ fn prepare<M: System<N> + ?Sized, const N: usize>(
     Ok(true)
 }
 
-/// The Runge–Kutta arithmetic of `L` lanes, `[stage][state][lane]`.
-struct Soa<const N: usize, const L: usize> {
-    k: [[[f64; L]; N]; 16],
-    z: [[f64; L]; N],
-    z_new: [[f64; L]; N],
-    e5: [[f64; L]; N],
-    e3: [[f64; L]; N],
+/// The Runge–Kutta arithmetic of the lanes, `[stage][state]` of [`f64x4`]
+/// (one number per lane; lane-wise IEEE products and sums, no fused
+/// multiply–add, so each lane's numbers are those of a single run).
+struct Soa<const N: usize> {
+    k: [[f64x4; N]; 16],
+    z: [f64x4; N],
+    z_new: [f64x4; N],
+    e5: [f64x4; N],
+    e3: [f64x4; N],
     t: [f64; L],
-    h: [f64; L],
+    h: f64x4,
 }
 
-impl<const N: usize, const L: usize> Soa<N, L> {
+/// Lane `l` of every state.
+#[inline(always)]
+fn lane_of<const N: usize>(v: &[f64x4; N], l: usize) -> [f64; N] {
+    std::array::from_fn(|i| v[i].as_array_ref()[l])
+}
+
+impl<const N: usize> Soa<N> {
     fn new() -> Self {
         Soa {
-            k: [[[0.0; L]; N]; 16],
-            z: [[0.0; L]; N],
-            z_new: [[0.0; L]; N],
-            e5: [[0.0; L]; N],
-            e3: [[0.0; L]; N],
+            k: [[f64x4::ZERO; N]; 16],
+            z: [f64x4::ZERO; N],
+            z_new: [f64x4::ZERO; N],
+            e5: [f64x4::ZERO; N],
+            e3: [f64x4::ZERO; N],
             t: [0.0; L],
-            h: [0.0; L],
+            h: f64x4::ZERO,
         }
     }
 
@@ -240,36 +253,40 @@ impl<const N: usize, const L: usize> Soa<N, L> {
         lanes: &mut [Option<Lane<'_, M, N>>; L],
         mask: &[bool; L],
     ) {
-        let y = combine_lanes::<N, L, S>(&self.k, &self.z, &A[S], &self.h);
+        let y = combine_lanes::<N, S>(&self.k, &self.z, &A[S], self.h);
         self.slopes(lanes, mask, S, &y, C[S]);
     }
 
-    /// `k[s] = f(t + c·h, y)` of every lane in `mask` (0 elsewhere).
-    #[inline(always)]
+    /// `k[s] = f(t + c·h, y)` of every lane in `mask` (0 elsewhere). Not
+    /// inlined: one copy of the right-hand side serves every stage, so the
+    /// code stays within the instruction cache.
+    #[inline(never)]
     fn slopes<M: System<N> + ?Sized>(
         &mut self,
         lanes: &mut [Option<Lane<'_, M, N>>; L],
         mask: &[bool; L],
         s: usize,
-        y: &[[f64; L]; N],
+        y: &[f64x4; N],
         c: f64,
     ) {
+        let h = self.h.to_array();
+        let mut out = [[0.0; N]; L];
         for (l, lane) in lanes.iter_mut().enumerate() {
-            let mut out = [0.0; N];
             if let (Some(lane), true) = (lane, mask[l]) {
                 let solver = &mut lane.solver;
-                let yl: [f64; N] = std::array::from_fn(|i| y[i][l]);
                 solver.stats.rhs_evals += 1;
                 let tc = if s == 12 {
-                    self.t[l] + self.h[l]
+                    self.t[l] + h[l]
                 } else {
-                    self.t[l] + c * self.h[l]
+                    self.t[l] + c * h[l]
                 };
-                solver.model.field(tc, &solver.modes, &yl, &mut out);
+                solver
+                    .model
+                    .field(tc, &solver.modes, &lane_of(y, l), &mut out[l]);
             }
-            for i in 0..N {
-                self.k[s][i][l] = out[i];
-            }
+        }
+        for i in 0..N {
+            self.k[s][i] = f64x4::new(std::array::from_fn(|l| out[l][i]));
         }
     }
 
@@ -280,19 +297,21 @@ impl<const N: usize, const L: usize> Soa<N, L> {
         lanes: &mut [Option<Lane<'_, M, N>>; L],
         active: &[bool; L],
     ) {
+        let mut h = [0.0; L];
+        let mut z = [[0.0; N]; L];
+        let mut f = [[0.0; N]; L];
         for l in 0..L {
-            let (t, h, z, f) = match &lanes[l] {
-                Some(lane) if active[l] => {
-                    (lane.solver.t, lane.attempt.0, lane.solver.z, lane.solver.f)
-                }
-                _ => (0.0, 0.0, [0.0; N], [0.0; N]),
-            };
-            self.t[l] = t;
-            self.h[l] = h;
-            for i in 0..N {
-                self.z[i][l] = z[i];
-                self.k[0][i][l] = f[i];
+            if let (Some(lane), true) = (&lanes[l], active[l]) {
+                self.t[l] = lane.solver.t;
+                h[l] = lane.attempt.0;
+                z[l] = lane.solver.z;
+                f[l] = lane.solver.f;
             }
+        }
+        self.h = f64x4::new(h);
+        for i in 0..N {
+            self.z[i] = f64x4::new(std::array::from_fn(|l| z[l][i]));
+            self.k[0][i] = f64x4::new(std::array::from_fn(|l| f[l][i]));
         }
         self.stage::<M, 1>(lanes, active);
         self.stage::<M, 2>(lanes, active);
@@ -305,36 +324,36 @@ impl<const N: usize, const L: usize> Soa<N, L> {
         self.stage::<M, 9>(lanes, active);
         self.stage::<M, 10>(lanes, active);
         self.stage::<M, 11>(lanes, active);
-        let z_new = combine_lanes::<N, L, 12>(&self.k, &self.z, &B, &self.h);
+        let z_new = combine_lanes::<N, 12>(&self.k, &self.z, &B, self.h);
         self.slopes(lanes, active, 12, &z_new, 1.0);
         self.z_new = z_new;
-        let zero = [[0.0; L]; N];
-        let one = [1.0; L];
-        self.e5 = combine_lanes::<N, L, 13>(&self.k, &zero, &E5, &one);
-        self.e3 = combine_lanes::<N, L, 13>(&self.k, &zero, &E3, &one);
+        let zero = [f64x4::ZERO; N];
+        let one = f64x4::splat(1.0);
+        self.e5 = combine_lanes::<N, 13>(&self.k, &zero, &E5, one);
+        self.e3 = combine_lanes::<N, 13>(&self.k, &zero, &E3, one);
     }
 
-    /// Lane `l`'s new state and error norm; its slopes 0…12 go to its solver.
+    /// Lane `l`'s new state and error norm.
     fn outcome<M: System<N> + ?Sized>(
         &self,
         l: usize,
         solver: &Solver<'_, M, N>,
     ) -> ([f64; N], f64) {
-        let col = |a: &[[f64; L]; N]| -> [f64; N] { std::array::from_fn(|i| a[i][l]) };
-        let z_new = col(&self.z_new);
+        let z_new = lane_of(&self.z_new, l);
+        let h = self.h.as_array_ref()[l];
         let err = solver.error_norm(
-            self.h[l],
-            &col(&self.z),
+            h,
+            &lane_of(&self.z, l),
             &z_new,
-            &col(&self.e5),
-            &col(&self.e3),
+            &lane_of(&self.e5, l),
+            &lane_of(&self.e3, l),
         );
         (z_new, err)
     }
 
     /// Lane `l`'s new state.
     fn z_new_of(&self, l: usize) -> [f64; N] {
-        std::array::from_fn(|i| self.z_new[i][l])
+        lane_of(&self.z_new, l)
     }
 
     /// The dense output's three extra stages of the accepted lanes and its
@@ -348,60 +367,59 @@ impl<const N: usize, const L: usize> Soa<N, L> {
         self.stage::<M, 13>(lanes, accepted);
         self.stage::<M, 14>(lanes, accepted);
         self.stage::<M, 15>(lanes, accepted);
-        let zero = [[0.0; L]; N];
-        let d: [[[f64; L]; N]; 4] = [
-            combine_lanes::<N, L, 16>(&self.k, &zero, &D[0], &self.h),
-            combine_lanes::<N, L, 16>(&self.k, &zero, &D[1], &self.h),
-            combine_lanes::<N, L, 16>(&self.k, &zero, &D[2], &self.h),
-            combine_lanes::<N, L, 16>(&self.k, &zero, &D[3], &self.h),
+        let zero = [f64x4::ZERO; N];
+        let d: [[f64x4; N]; 4] = [
+            combine_lanes::<N, 16>(&self.k, &zero, &D[0], self.h),
+            combine_lanes::<N, 16>(&self.k, &zero, &D[1], self.h),
+            combine_lanes::<N, 16>(&self.k, &zero, &D[2], self.h),
+            combine_lanes::<N, 16>(&self.k, &zero, &D[3], self.h),
         ];
         for (l, lane) in lanes.iter_mut().enumerate() {
             let (Some(lane), true) = (lane, accepted[l]) else {
                 continue;
             };
             let solver = &mut lane.solver;
-            for i in 0..N {
-                for r in 0..4 {
-                    solver.dense[3 + r][i] = d[r][i][l];
-                }
-                solver.k[0][i] = self.k[0][i][l];
-                solver.k[12][i] = self.k[12][i][l];
+            for r in 0..4 {
+                solver.dense[3 + r] = lane_of(&d[r], l);
             }
+            solver.k[0] = lane_of(&self.k[0], l);
+            solver.k[12] = lane_of(&self.k[12], l);
         }
     }
 }
 
-/// [`super::combine`] for `L` lanes at once: `base + Σ_{j<J} (h_l·row[j])·k[j]`
+/// [`super::combine`] for all lanes at once: `base + Σ_{j<J} (h·row[j])·k[j]`
 /// lane by lane, the terms in the same order, so each lane's sums are bit
-/// for bit those of a single run. State by state, so that the lanes' partial
-/// sums stay in registers.
+/// for bit those of a single run.
 #[inline(always)]
-fn combine_lanes<const N: usize, const L: usize, const J: usize>(
-    k: &[[[f64; L]; N]; 16],
-    base: &[[f64; L]; N],
+fn combine_lanes<const N: usize, const J: usize>(
+    k: &[[f64x4; N]; 16],
+    base: &[f64x4; N],
     row: &[f64],
-    h: &[f64; L],
-) -> [[f64; L]; N] {
-    let mut a = [[0.0; L]; 16];
-    for j in 0..J {
-        for l in 0..L {
-            a[j][l] = h[l] * row[j];
-        }
-    }
+    h: f64x4,
+) -> [f64x4; N] {
+    // State by state, the terms innermost: one state's lanes stay in a
+    // register while its terms are added (all states at once would spill).
+    let mut a = [f64x4::ZERO; 16];
     let mut y = *base;
-    for i in 0..N {
-        let mut yi = y[i];
-        macro_rules! terms {
-            ($($j:literal)*) => {$(
+    macro_rules! unrolled {
+        ($($j:literal)*) => {
+            $(
                 if $j < J && row[$j] != 0.0 {
-                    for l in 0..L {
-                        yi[l] += a[$j][l] * k[$j][i][l];
-                    }
+                    a[$j] = h * f64x4::splat(row[$j]);
                 }
-            )*};
-        }
-        terms!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
-        y[i] = yi;
+            )*
+            for i in 0..N {
+                let mut yi = y[i];
+                $(
+                    if $j < J && row[$j] != 0.0 {
+                        yi += a[$j] * k[$j][i];
+                    }
+                )*
+                y[i] = yi;
+            }
+        };
     }
+    unrolled!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
     y
 }
