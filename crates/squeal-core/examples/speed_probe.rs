@@ -85,6 +85,21 @@ fn main() {
         }
         return;
     }
+    if what == "state" {
+        // The end state of the 0.3 s window (for the peers' accuracy check).
+        let rtol: f64 = std::env::args().nth(2).and_then(|s| s.parse().ok()).unwrap_or(1e-8);
+        let opts = SolverOptions {
+            rtol,
+            ..SolverOptions::default()
+        };
+        let mut solver = squeal_core::Solver::new(&disc, 0.0, [0.0; 8], 0.3, opts).unwrap();
+        while solver.step().unwrap().is_some() {}
+        let z = solver.state();
+        let s = solver.stats();
+        println!("squeal: {} steps, {} rhs", s.accepted, s.rhs_evals);
+        println!("end state: {}", z.map(|x| format!("{x:.12e}")).join(" "));
+        return;
+    }
     if what == "lanes" {
         // `lanes L`: 16 disc–pads (V from 0.8 to 1.55 m/s), 0.3 s from rest at
         // 200 kHz, L at a time (L = 1: `simulate` one after the other).
