@@ -1191,3 +1191,106 @@ impl Feed {
         None
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (no dependency): xorshift64*.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            let u = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
+            u as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        }
+    }
+
+    /// The unrolled combinations add the same terms in the same order as the
+    /// plain loop over the tableau row that skips zeros at run time.
+    #[test]
+    fn unrolled_combinations_equal_the_runtime_loop_bit_for_bit() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        for _ in 0..200 {
+            let mut k = [[0.0; 8]; 16];
+            for row in k.iter_mut() {
+                for x in row.iter_mut() {
+                    *x = rng.next() * 10f64.powi((rng.next() * 8.0) as i32);
+                }
+            }
+            let base: [f64; 8] = std::array::from_fn(|_| rng.next());
+            let h = 1e-6 * (1.5 + rng.next());
+            let plain = |row: &[f64], upto: usize, h: f64| {
+                let mut y = base;
+                for j in 0..upto {
+                    let a = h * row[j];
+                    if a != 0.0 {
+                        for i in 0..8 {
+                            y[i] += a * k[j][i];
+                        }
+                    }
+                }
+                y
+            };
+            let bits = |y: [f64; 8]| y.map(f64::to_bits);
+            assert_eq!(
+                bits(combine::<8, 5>(&k, &base, &A[5], h)),
+                bits(plain(&A[5], 5, h))
+            );
+            assert_eq!(
+                bits(combine::<8, 11>(&k, &base, &A[11], h)),
+                bits(plain(&A[11], 11, h))
+            );
+            assert_eq!(
+                bits(combine::<8, 15>(&k, &base, &A[15], h)),
+                bits(plain(&A[15], 15, h))
+            );
+            assert_eq!(
+                bits(combine::<8, 12>(&k, &base, &B, h)),
+                bits(plain(&B, 12, h))
+            );
+            assert_eq!(
+                bits(combine::<8, 13>(&k, &base, &E5, 1.0)),
+                bits(plain(&E5, 13, 1.0))
+            );
+            assert_eq!(
+                bits(combine::<8, 16>(&k, &base, &D[2], h)),
+                bits(plain(&D[2], 16, h))
+            );
+        }
+    }
+
+    /// Whenever the cheap bound dismisses a guard, the guard is negative on
+    /// the whole step (dense sampling) and the root search finds nothing;
+    /// and the bound does dismiss the easy cases.
+    #[test]
+    fn dismissed_guards_have_no_crossing() {
+        let mut rng = Rng(0x1234_5678_9abc_def1);
+        let mut dismissed = 0;
+        for n in 0..20_000 {
+            let g0 = -rng.next().abs() - 1e-3;
+            // Coefficients from tiny to a little more than |g0|.
+            let scale = g0.abs() * 10f64.powf(-4.0 * rng.next().abs()) * 0.3;
+            let g: [f64; 7] = std::array::from_fn(|_| scale * rng.next());
+            if !clearly_negative(g0, &g) {
+                continue;
+            }
+            dismissed += 1;
+            let p = power_basis(g0, &g);
+            assert_eq!(roots::first_upcrossing(&p, 1e-12), None, "case {n}");
+            for s in 0..=200 {
+                let x = s as f64 / 200.0;
+                assert!(roots::horner(&p, x) < 0.0, "case {n} at θ = {x}");
+            }
+        }
+        assert!(dismissed > 5_000, "{dismissed} dismissed");
+        // Not dismissed: a guard that reaches zero within the bound.
+        assert!(!clearly_negative(
+            -1.0,
+            &[0.5, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0]
+        ));
+        assert!(!clearly_negative(0.0, &[0.0; 7]));
+    }
+}
