@@ -39,6 +39,7 @@ use super::{
 };
 use crate::friction::FrictionLaw;
 use crate::params::ParamError;
+use crate::stability::projected::{ModalOptions, SecondOrder};
 use nalgebra::DMatrix;
 
 /// A bad model description: one line naming the element and key.
@@ -269,6 +270,9 @@ pub struct Lumped {
     pub forces: Vec<Force>,
     /// Contacts.
     pub contacts: Vec<Contact>,
+    /// How the complex eigenvalue analysis is solved (dense or projected;
+    /// keys `modal.dense_max_dofs`, `modal.modes`, `modal.cutoff_hz`).
+    pub modal: ModalOptions,
     // Derived from the above by `refresh`.
     inv_mass: InvMass,
     /// `M⁻¹ t_j` per contact, dense.
@@ -455,9 +459,9 @@ impl Lumped {
                     "{kind} '{name}': name: not a valid element name (no '.', '=', ',' or spaces)"
                 ));
             }
-            if name == "mass" || names.iter().any(|x| x == name) {
+            if name == "mass" || name == "modal" || names.iter().any(|x| x == name) {
                 return bad(format!(
-                    "{kind} '{name}': name: already used (element names must be unique and not 'mass')"
+                    "{kind} '{name}': name: already used (element names must be unique and not 'mass' or 'modal')"
                 ));
             }
             names.push(name.to_string());
@@ -615,6 +619,7 @@ impl Lumped {
             springs,
             forces,
             contacts,
+            modal: ModalOptions::default(),
             inv_mass: InvMass::Diagonal(Vec::new()),
             minv_t: Vec::new(),
             gram: [[0.0; MAX_CONTACTS]; MAX_CONTACTS],
@@ -1203,6 +1208,42 @@ impl Lumped {
         }
     }
 
+    /// The linearised second-order system `M q̈ + C q̇ + K q = 0` of the
+    /// sliding equations at `z` (the same linearisation as
+    /// [`Lumped::jacobian_dyn`], `M` with the `[masses]` added, `K`, `C` the
+    /// negated force Jacobian, non-symmetric where friction acts).
+    pub fn second_order_dyn(&self, z: &[f64]) -> SecondOrder {
+        let n = self.dofs.len();
+        let modes = self.sliding_modes_at(z);
+        let jf = self.force_jacobian(&modes, z);
+        let mut m = DMatrix::<f64>::zeros(n, n);
+        if let Some(mm) = &self.m_matrix {
+            for (r, c, v) in mm.entries() {
+                m[(r, c)] += v;
+            }
+        }
+        for i in 0..n {
+            m[(i, i)] += self.masses[i];
+        }
+        SecondOrder {
+            m,
+            k: -jf.columns(0, n),
+            c: -jf.columns(n, n),
+        }
+    }
+
+    /// The analysis options' keys (`modal.dense_max_dofs`, `modal.modes`,
+    /// `modal.cutoff_hz`); not in [`Lumped::keys`] (they are not physical
+    /// parameters to sweep).
+    fn modal_get(&self, key: &str) -> Option<f64> {
+        match key {
+            "modal.dense_max_dofs" => Some(self.modal.dense_max_dofs as f64),
+            "modal.modes" => Some(self.modal.modes as f64),
+            "modal.cutoff_hz" => Some(self.modal.cutoff_hz),
+            _ => None,
+        }
+    }
+
     // ---- Parameters: `<element>.<key>` and `mass.<dof>` ----
 
     /// Every parameter key with its current value, in file order.
@@ -1243,6 +1284,9 @@ impl Lumped {
 
     /// Value of a parameter by key.
     pub fn get(&self, key: &str) -> Option<f64> {
+        if let Some(v) = self.modal_get(key) {
+            return Some(v);
+        }
         self.keys()
             .into_iter()
             .find(|(k, _)| k == key)
@@ -1251,7 +1295,9 @@ impl Lumped {
 
     /// Set a parameter by key, checking its range; the model is re-checked
     /// (stick constraints, mass matrix) afterwards. Keys are
-    /// `<element>.<key>` and `mass.<dof>`.
+    /// `<element>.<key>`, `mass.<dof>` and the analysis options
+    /// `modal.dense_max_dofs`, `modal.modes`, `modal.cutoff_hz`
+    /// ([`ModalOptions`]).
     pub fn set(&mut self, key: &str, value: f64) -> Result<(), ParamError> {
         let invalid = |why: &str| ParamError::Invalid {
             key: key.into(),
@@ -1310,6 +1356,25 @@ impl Lumped {
                 }
                 _ => return Err(unknown()),
             }
+        } else if el == "modal" {
+            let count = |v: f64| {
+                if v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v <= 1e9 {
+                    Ok(v as usize)
+                } else {
+                    Err(invalid("must be a whole number ≥ 0"))
+                }
+            };
+            match k {
+                "dense_max_dofs" => self.modal.dense_max_dofs = count(value)?,
+                "modes" => self.modal.modes = count(value)?,
+                "cutoff_hz" => {
+                    if !(value.is_finite() && value > 0.0) {
+                        return Err(invalid("must be a finite frequency > 0 (Hz)"));
+                    }
+                    self.modal.cutoff_hz = value;
+                }
+                _ => return Err(unknown()),
+            }
         } else {
             return Err(unknown());
         }
@@ -1336,6 +1401,13 @@ impl Lumped {
         let (el, k) = key.split_once('.')?;
         if el == "mass" {
             return Some(("kg", format!("mass of dof {k}")));
+        }
+        if el == "modal" && self.modal_get(key).is_some() {
+            return Some(match k {
+                "dense_max_dofs" => ("", "largest model (dofs) solved by the dense eigen-analysis; larger ones by projection onto undamped modes".to_string()),
+                "modes" => ("", "number of undamped modes of the projection basis (0: by modal.cutoff_hz)".to_string()),
+                _ => ("Hz", "highest undamped frequency of the projection basis".to_string()),
+            });
         }
         if self.springs.iter().any(|s| s.name == el) {
             return match k {
@@ -1373,6 +1445,13 @@ impl Lumped {
         let (el, k) = key.split_once('.').unwrap_or(("", key));
         if el == "mass" {
             return ParamKind::Positive;
+        }
+        if el == "modal" {
+            return if k == "cutoff_hz" {
+                ParamKind::Positive
+            } else {
+                ParamKind::NonNegative
+            };
         }
         match k {
             "value" | "V" | "alpha" => ParamKind::Any,
