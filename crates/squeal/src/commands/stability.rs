@@ -123,7 +123,28 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
         "least_stable": { "re": ls.re, "im": ls.im, "freq_hz": ls.freq_hz, "dominant": ls.dominant_name },
         "equilibrium": eq,
         "shape_normalisation": SHAPE_NORMALISATION,
+        "modal": modal_json(an),
     })
+}
+
+/// How the eigenvalues were computed: `{"method": "dense"}` or
+/// `{"method": "projected", "modes": m, "dofs": n, "basis_max_hz": f}`.
+pub fn modal_json(an: &Analysis) -> Value {
+    serde_json::to_value(an.method).unwrap_or(Value::Null)
+}
+
+/// One line saying that the analysis is a reduced-basis one, if it is.
+pub fn modal_line(an: &Analysis) -> Option<String> {
+    match an.method {
+        squeal_core::stability::projected::Method::Dense => None,
+        squeal_core::stability::projected::Method::Projected {
+            modes,
+            dofs,
+            basis_max_hz,
+        } => Some(format!(
+            "projected onto the {modes} lowest undamped modes of {dofs} dofs (up to {basis_max_hz:.1} Hz): a reduced-basis answer for the modes in that band, none above it (modal.modes / modal.cutoff_hz / modal.dense_max_dofs choose)"
+        )),
+    }
 }
 
 /// `stable` (every σ < 0 beyond round-off), `neutral` (no mode grows, some
@@ -275,6 +296,9 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         sc.model.name(),
         an.max_growth_rate
     );
+    if let Some(line) = modal_line(&an) {
+        crate::outln!("{line}");
+    }
     crate::outln!(
         "{:>3}  {:>15}  {:>15}  {:>12}  {:>14}  dominant",
         "#",
