@@ -211,6 +211,20 @@ fn main() {
             "lumped::analyse + mode shapes, disc-pad + chain, {n} dofs, {:?}, one thread: {dt:.2} s (sigma_max {:.6})",
             an.method, an.max_growth_rate
         );
+        // What simulating it would cost: the fastest mode bounds an explicit
+        // method's step (integrate::budget).
+        let z = l.equilibrium_dyn().unwrap();
+        let all = squeal_core::stability::projected::undamped_basis(
+            &l.second_order_dyn(&z),
+            squeal_core::stability::projected::Basis::Modes(n),
+        )
+        .unwrap();
+        let w_max = all.omega2.last().unwrap().sqrt();
+        println!(
+            "  highest undamped frequency {:.0} Hz: an explicit run of 1 s needs at least {:.3e} DOP853 steps (integrate::budget::min_steps)",
+            w_max / (2.0 * std::f64::consts::PI),
+            squeal_core::integrate::budget::min_steps(w_max, 1.0, f64::INFINITY)
+        );
         let sys = oscillators_second_order(n);
         let names: Vec<String> = (0..2 * n).map(|i| format!("s{i}")).collect();
         let t = Instant::now();
