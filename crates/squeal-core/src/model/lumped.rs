@@ -33,7 +33,7 @@
 //!
 //! State `z = (q, q̇)`; positions named after the dofs, velocities `v<dof>`.
 
-use super::contact::{Combination, Contact, Normal};
+use super::contact::{self, Combination, Contact, Normal};
 use super::{
     EventKind, Guard, GuardKind, Guards, Mode, ModelError, Modes, Observables, System, MAX_CONTACTS,
 };
@@ -1539,18 +1539,21 @@ impl<const N: usize> System<N> for Lumped {
                     normal, k, c: cc, ..
                 } = &c.normal
                 {
-                    let mut g = [0.0; N];
-                    normal.add_scaled(&mut g[..n], -k);
-                    normal.add_scaled(&mut g[n..], -cc);
-                    push(GuardKind::Separation, g, 0.0, true);
+                    // F_n = k δ + c δ̇.
+                    let mut f_n = [0.0; N];
+                    normal.add_scaled(&mut f_n[..n], *k);
+                    normal.add_scaled(&mut f_n[n..], *cc);
+                    let (g, d) = contact::separation_guard(&(f_n, 0.0));
+                    push(GuardKind::Separation, g, d, true);
                 }
             }
             match mode {
                 Mode::SlipPos | Mode::SlipNeg => {
-                    let s = mode.slip_sign();
-                    let mut g = [0.0; N];
-                    c.tangent.add_scaled(&mut g[n..], -s);
-                    push(GuardKind::SlipZero, g, -s * c.v, true);
+                    // v = V + t·q̇.
+                    let mut v = [0.0; N];
+                    c.tangent.add_scaled(&mut v[n..], 1.0);
+                    let (g, d) = contact::slip_zero_guard(mode, &(v, c.v));
+                    push(GuardKind::SlipZero, g, d, true);
                 }
                 Mode::Stick => {
                     for (kind, sign) in [
@@ -1697,50 +1700,42 @@ impl<const N: usize> System<N> for Lumped {
         let i = g.contact as usize;
         let old = modes.get(i);
         let mut next = *modes;
-        match g.kind {
-            GuardKind::SlipZero => {
-                // On the surface v = 0 exactly: the mass-weighted projection
-                // u ← u − v·M⁻¹t/(t·M⁻¹t).
-                let c = &self.contacts[i];
-                let v = c.sliding_velocity(&z[n..]);
-                let w = v / self.gram[i][i];
-                for k in 0..n {
-                    z[n + k] -= w * self.minv_t[i][k];
-                }
-                let m = self.contact_mode(t, &next, i, &z[..]);
-                // Reached v = 0 without leaving the contact: stick or slip on.
-                let m = if m == Mode::Free { old } else { m };
-                next.set(i, m);
-                (next, Contact::event(old, m))
-            }
-            GuardKind::StickBreakPos => {
-                next.set(i, Mode::SlipPos);
-                (next, Some(EventKind::Slip))
-            }
-            GuardKind::StickBreakNeg => {
-                next.set(i, Mode::SlipNeg);
-                (next, Some(EventKind::Slip))
-            }
-            GuardKind::Separation => {
-                next.set(i, Mode::Free);
-                (next, Some(EventKind::Separate))
-            }
-            GuardKind::Contact => {
-                // On the surface δ = 0: decide the friction mode as in contact.
-                let c = &self.contacts[i];
-                let f_n = c.normal_force(&z[..n], &z[n..]);
-                let v = c.sliding_velocity(&z[n..]);
-                let m = if v != 0.0 {
-                    c.mode_for(v, 0.0, f_n)
-                } else {
-                    let mut trial = next;
-                    trial.set(i, Mode::Stick);
-                    c.mode_for(0.0, self.stick_force(t, &trial, i, &z[..]), f_n)
-                };
-                next.set(i, m);
-                (next, Some(EventKind::Contact))
+        let c = &self.contacts[i];
+        if g.kind == GuardKind::SlipZero {
+            // On the surface v = 0 exactly: the mass-weighted projection
+            // u ← u − v·M⁻¹t/(t·M⁻¹t).
+            let v = c.sliding_velocity(&z[n..]);
+            let w = v / self.gram[i][i];
+            for k in 0..n {
+                z[n + k] -= w * self.minv_t[i][k];
             }
         }
+        let z = &*z;
+        let (m, event) = contact::after_guard(g.kind, old, || {
+            if g.kind == GuardKind::SlipZero {
+                let m = self.contact_mode(t, modes, i, &z[..]);
+                // Reached v = 0 without leaving the contact: stick or slip on.
+                if m == Mode::Free {
+                    old
+                } else {
+                    m
+                }
+            } else {
+                // On the surface δ = 0: decide the friction mode as in contact.
+                let f_n = c.normal_force(&z[..n], &z[n..]);
+                let v = c.sliding_velocity(&z[n..]);
+                let f_stick = if v != 0.0 {
+                    0.0
+                } else {
+                    let mut trial = *modes;
+                    trial.set(i, Mode::Stick);
+                    self.stick_force(t, &trial, i, &z[..])
+                };
+                c.mode_for(v, f_stick, f_n)
+            }
+        });
+        next.set(i, m);
+        (next, event)
     }
 
     fn start_modes(&self, t: f64, z: &[f64; N]) -> Modes {
