@@ -264,11 +264,13 @@ pub struct Lumped {
     m_matrix: Option<Sparse>,
     k_matrix: Option<Sparse>,
     c_matrix: Option<Sparse>,
-    /// Springs.
+    /// Springs. Change their parameters through [`Lumped::set`]: the
+    /// right-hand side of a small model uses operators derived from them.
     pub springs: Vec<Spring>,
-    /// Forces.
+    /// Forces (as [`Lumped::springs`]: change them through [`Lumped::set`]).
     pub forces: Vec<Force>,
-    /// Contacts.
+    /// Contacts (their combinations are derived into the right-hand side's
+    /// operators; laws, `V`, `alpha`, `k`, `c` are read directly).
     pub contacts: Vec<Contact>,
     /// How the complex eigenvalue analysis is solved (dense or projected;
     /// keys `modal.dense_max_dofs`, `modal.modes`, `modal.cutoff_hz`).
@@ -282,6 +284,42 @@ pub struct Lumped {
     /// `t_i·M⁻¹ n_j`.
     tn: [[f64; MAX_CONTACTS]; MAX_CONTACTS],
     has_ramp: bool,
+    /// Dense operators of the right-hand side (models of at most
+    /// [`DENSE_FIELD_DOFS`] dofs); rebuilt whenever a parameter changes.
+    dense: Option<DenseField>,
+}
+
+/// Up to this many dofs the right-hand side runs on dense operators
+/// ([`DenseField`]): contiguous dot products instead of the elements' sparse
+/// coefficient lists.
+pub const DENSE_FIELD_DOFS: usize = 16;
+
+/// The right-hand side of a small model as folded sparse operators: every
+/// spring, `K` and `C` in one list of non-zero entries of the `n × 2n`
+/// matrix `∂force/∂z`, the constant forces in one vector, each contact's
+/// combinations as `(index, coefficient)` pairs on the state.
+#[derive(Debug, Clone, PartialEq, Default)]
+struct DenseField {
+    /// Number of dofs.
+    n: usize,
+    /// `(row, column on z, value)`: the force of springs, `K` and `C` is
+    /// `Σ value·z[column]` into `row` (duplicates summed at build).
+    kc: Vec<(usize, usize, f64)>,
+    /// `Σ value·on` of the forces without a ramp.
+    f0: Vec<f64>,
+    /// Per contact: `F_n` on `z` (`(k n, c n)`), the normal on the dofs,
+    /// the sliding velocity's `t` on `z` (velocities), the slope on `z`.
+    contacts: Vec<[Vec<(usize, f64)>; 4]>,
+}
+
+/// `Σ coef·z[index]`.
+#[inline(always)]
+fn dot_pairs(pairs: &[(usize, f64)], z: &[f64]) -> f64 {
+    let mut s = 0.0;
+    for &(i, c) in pairs {
+        s += c * z[i];
+    }
+    s
 }
 
 /// Up to this many dofs, guard evaluations use a stack buffer (no allocation).
@@ -625,6 +663,7 @@ impl Lumped {
             gram: [[0.0; MAX_CONTACTS]; MAX_CONTACTS],
             tn: [[0.0; MAX_CONTACTS]; MAX_CONTACTS],
             has_ramp: false,
+            dense: None,
         };
         model.refresh()?;
         Ok(model)
@@ -727,7 +766,126 @@ impl Lumped {
                 }
             }
         }
+        self.rebuild_dense();
         Ok(())
+    }
+
+    /// Rebuild the dense operators of the right-hand side ([`DenseField`])
+    /// from the elements (small models only).
+    fn rebuild_dense(&mut self) {
+        let n = self.dofs.len();
+        if n > DENSE_FIELD_DOFS {
+            self.dense = None;
+            return;
+        }
+        let mut kc = vec![0.0; 2 * n * n];
+        for sp in &self.springs {
+            for (a, ca) in sp.on.idx.iter().zip(&sp.on.coef) {
+                for (b, cb) in sp.on.idx.iter().zip(&sp.on.coef) {
+                    kc[a * 2 * n + b] -= sp.k * ca * cb;
+                    kc[a * 2 * n + n + b] -= sp.c * ca * cb;
+                }
+            }
+        }
+        if let Some(k) = &self.k_matrix {
+            for (r, c, v) in k.entries() {
+                kc[r * 2 * n + c] -= v;
+            }
+        }
+        if let Some(cm) = &self.c_matrix {
+            for (r, c, v) in cm.entries() {
+                kc[r * 2 * n + n + c] -= v;
+            }
+        }
+        let mut f0 = vec![0.0; n];
+        for f in self.forces.iter().filter(|f| f.ramp <= 0.0) {
+            f.on.add_scaled(&mut f0, f.value);
+        }
+        let pairs = |v: &[f64]| -> Vec<(usize, f64)> {
+            v.iter()
+                .enumerate()
+                .filter(|(_, x)| **x != 0.0)
+                .map(|(i, x)| (i, *x))
+                .collect()
+        };
+        let contacts = self
+            .contacts
+            .iter()
+            .map(|c| {
+                let mut f_n = vec![0.0; 2 * n];
+                let mut nrm = vec![0.0; n];
+                if let Normal::Elastic {
+                    normal, k, c: cc, ..
+                } = &c.normal
+                {
+                    normal.add_scaled(&mut f_n[..n], *k);
+                    normal.add_scaled(&mut f_n[n..], *cc);
+                    normal.add_scaled(&mut nrm, 1.0);
+                }
+                let mut tan = vec![0.0; 2 * n];
+                c.tangent.add_scaled(&mut tan[n..], 1.0);
+                let mut slope = vec![0.0; 2 * n];
+                c.slope.add_scaled(&mut slope[..n], 1.0);
+                [pairs(&f_n), pairs(&nrm), pairs(&tan), pairs(&slope)]
+            })
+            .collect();
+        self.dense = Some(DenseField {
+            n,
+            kc: kc
+                .iter()
+                .enumerate()
+                .filter(|(_, x)| **x != 0.0)
+                .map(|(k, x)| (k / (2 * n), k % (2 * n), *x))
+                .collect(),
+            f0,
+            contacts,
+        });
+    }
+
+    /// The generalised force without stick multipliers on the folded
+    /// operators ([`DenseField`]) into `acc[..n]`: the same force as
+    /// [`Lumped::base_force`] (summed in another order).
+    #[inline(always)]
+    fn base_force_fixed(&self, d: &DenseField, t: f64, modes: &Modes, z: &[f64], acc: &mut [f64]) {
+        acc.copy_from_slice(&d.f0);
+        if self.has_ramp {
+            for f in self.forces.iter().filter(|f| f.ramp > 0.0) {
+                f.on.add_scaled(acc, f.value * f.factor(t));
+            }
+        }
+        for &(r, c, v) in &d.kc {
+            acc[r] += v * z[c];
+        }
+        for ((i, c), [f_n_on, nrm, tan, slope]) in self.contacts.iter().enumerate().zip(&d.contacts)
+        {
+            let mode = modes.get(i);
+            if mode == Mode::Free {
+                continue;
+            }
+            let f_n = match &c.normal {
+                Normal::Elastic { .. } => {
+                    let f_n = dot_pairs(f_n_on, z);
+                    for &(j, x) in nrm {
+                        acc[j] -= f_n * x;
+                    }
+                    f_n
+                }
+                Normal::Prescribed(f) => *f,
+            };
+            if mode != Mode::Stick {
+                let f_t = c.slip_force(mode, c.v + dot_pairs(tan, z), f_n);
+                let n = d.n;
+                for &(j, x) in tan {
+                    acc[j - n] -= f_t * x;
+                }
+                if c.alpha != 0.0 && matches!(c.normal, Normal::Elastic { .. }) {
+                    let f_f = c.alpha * f_t * dot_pairs(slope, z);
+                    for &(j, x) in nrm {
+                        acc[j] += f_f * x;
+                    }
+                }
+            }
+        }
     }
 
     /// `M⁻¹ x` (allocating; for set-up).
@@ -876,6 +1034,13 @@ impl Lumped {
         acc: &mut [f64],
     ) -> [f64; MAX_CONTACTS] {
         self.base_force(t, modes, q, u, acc, true);
+        self.add_stick_forces(modes, q, acc)
+    }
+
+    /// Add the sticking contacts' forces (the multipliers for the force
+    /// `acc` without them) to `acc`; the multipliers indexed by contact.
+    #[inline]
+    fn add_stick_forces(&self, modes: &Modes, q: &[f64], acc: &mut [f64]) -> [f64; MAX_CONTACTS] {
         let (set, k) = stick_set(modes);
         let mut out = [0.0; MAX_CONTACTS];
         if k > 0 {
@@ -1385,6 +1550,7 @@ impl Lumped {
                 why: e.0,
             })?;
         }
+        self.rebuild_dense();
         Ok(())
     }
 
@@ -1505,7 +1671,17 @@ impl<const N: usize> System<N> for Lumped {
         let n = N / 2;
         let (q, u) = z.split_at(n);
         let mut acc = [0.0; N];
-        self.force(t, modes, q, u, &mut acc[..n]);
+        match &self.dense {
+            Some(d) => {
+                self.base_force_fixed(d, t, modes, z, &mut acc[..n]);
+                if modes.as_slice().contains(&Mode::Stick) {
+                    self.add_stick_forces(modes, q, &mut acc[..n]);
+                }
+            }
+            _ => {
+                self.force(t, modes, q, u, &mut acc[..n]);
+            }
+        }
         dz[..n].copy_from_slice(u);
         self.apply_inv_mass(&acc[..n], &mut dz[n..]);
     }
