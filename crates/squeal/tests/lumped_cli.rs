@@ -315,6 +315,27 @@ mu_k = 0.3
         human.contains("projected onto the 20 lowest undamped modes of 300 dofs"),
         "{human}"
     );
+    // The same options from the file's [modal] table.
+    let text = std::fs::read_to_string(d.path().join("big.toml")).unwrap();
+    std::fs::write(
+        d.path().join("big-modal.toml"),
+        format!("{text}\n[modal]\ndense_max_dofs = 0\nmodes = 20\n"),
+    )
+    .unwrap();
+    let f = json(&squeal(
+        d.path(),
+        &["stability", "big-modal.toml", "--json"],
+    ));
+    assert_eq!(f["modal"], s["modal"]);
+    assert_eq!(f["eigenvalues"], s["eigenvalues"]);
+    std::fs::write(
+        d.path().join("bad-modal.toml"),
+        format!("{text}\n[modal]\nshift = 3\n"),
+    )
+    .unwrap();
+    let out = squeal(d.path(), &["stability", "bad-modal.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("modal.shift"));
     let out = squeal(
         d.path(),
         &["stability", "big.toml", "--set", "modal.modes=2.5"],
