@@ -289,9 +289,10 @@ pub struct Lumped {
     dense: Option<DenseField>,
 }
 
-/// Up to this many dofs the right-hand side runs on dense operators
-/// ([`DenseField`]): contiguous dot products instead of the elements' sparse
-/// coefficient lists.
+/// Up to this many dofs the simulated right-hand side runs on operators
+/// folded once per parameter change (every spring, `K` and `C` in one list
+/// of non-zero entries, the constant forces in one vector) instead of
+/// looping over the elements.
 pub const DENSE_FIELD_DOFS: usize = 16;
 
 /// The right-hand side of a small model as folded sparse operators: every
