@@ -4,16 +4,15 @@
 //! where that fails is settled afresh by simulation), with the changes of
 //! stability and of the event structure along the branch reported.
 
-use crate::commands::cycle::{self, events_json, Found};
 use crate::commands::simulate::resolve;
-use crate::run::{RunError, Staging};
-use crate::scenario::{InputError, Scenario};
+use crate::run::{RunError, Staging, NEVER};
 use crate::ScenarioArgs;
 use clap::Args;
-use serde_json::{json, Value};
-use squeal_core::cycle::Section;
 use squeal_core::EventKind;
 use squeal_plot::{Format, Panel, Series};
+use squeal_study::branch::{check, follow, values, BranchPoint};
+use squeal_study::scenario::{InputError, Scenario};
+use squeal_study::NoProgress;
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
@@ -54,144 +53,23 @@ fn parse_range(spec: &str) -> Result<(String, f64, f64, usize), InputError> {
     Ok((name.trim().to_string(), lo, hi, n))
 }
 
-/// One point of the branch.
-struct Point {
-    value: f64,
-    found: Found,
-}
-
-/// What changes between two neighbouring points: a bifurcation's name.
-fn transition(a: &Found, b: &Found) -> Vec<String> {
-    let mut out = Vec::new();
-    if a.events != b.events {
-        let show = |e: &[u64; 5]| {
-            EventKind::ALL
-                .iter()
-                .filter(|k| e[k.index()] > 0)
-                .map(|k| format!("{} {}", e[k.index()], k.as_str()))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        out.push(format!(
-            "grazing/sliding: the events per period change ({} → {})",
-            show(&a.events),
-            show(&b.events)
-        ));
-    }
-    if a.stable != b.stable {
-        // The multiplier that crossed the unit circle: the largest non-trivial
-        // one on the unstable side.
-        let side = if a.stable { b } else { a };
-        let crit = side
-            .multipliers
-            .iter()
-            .filter(|m| !m.2)
-            .max_by(|x, y| x.0.hypot(x.1).total_cmp(&y.0.hypot(y.1)));
-        let kind = match crit {
-            Some(&(re, im, _)) if im.abs() > 1e-9 * re.hypot(im) => "Neimark–Sacker",
-            Some(&(re, _, _)) if re < 0.0 => "period doubling",
-            _ => "fold (a real multiplier through +1)",
-        };
-        out.push(format!(
-            "{kind}: stability {} → {}",
-            if a.stable { "stable" } else { "unstable" },
-            if b.stable { "stable" } else { "unstable" }
-        ));
-    }
-    if (b.period / a.period - 1.0).abs() > 0.5 {
-        out.push(format!(
-            "the period jumps ({:.6e} → {:.6e} s): another cycle",
-            a.period, b.period
-        ));
-    }
-    out
-}
-
 /// Run the command.
 pub fn run(a: BranchArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
     let (name, lo, hi, n) = parse_range(&a.param)?;
-    if sc.model.get(&name).is_none() {
-        return Err(InputError(format!(
-            "--param {name}: unknown parameter for model {}",
-            sc.model.name()
-        ))
-        .into());
-    }
-    sc.model.check_simulable().map_err(InputError)?;
-    // i9's validation path, the part that applies to a cycle (which budgets
-    // its own settling): a linearisation that overflows is named by parameter.
-    crate::feasible::scales(&sc.model, Some(&sc))
-        .map_err(|e| crate::feasible::stability_failure(&sc.model, e))?;
-    let values: Vec<f64> = (0..n)
-        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
-        .collect();
-    // Every value must be acceptable before any work.
-    for &v in &values {
-        let mut m = sc.model.clone();
-        m.set(&name, v)
-            .and_then(|_| m.validate())
-            .map_err(|e| InputError(format!("--param {name}={v}: {e}")))?;
-    }
+    let values = values(lo, hi, n);
+    check(&sc, &name, &values)?;
     let stage = Staging::new(&a.out)?;
-    let opts = cycle::options(&sc, 20_000_000, 1000.0);
     let names = sc.model.state_names();
-    let mut points: Vec<Point> = Vec::with_capacity(n);
-    let mut failures: Vec<Value> = Vec::new();
-    for &v in &values {
-        let mut p = sc.clone();
-        p.model
-            .set(&name, v)
-            .map_err(|e| InputError(e.to_string()))?;
-        let prev = points.last().map(|q| &q.found);
-        let found = continue_from(&p, prev, &names, &opts)
-            .or_else(|_| cycle::of_scenario(&p, &opts, false));
-        match found {
-            Ok(f) => points.push(Point { value: v, found: f }),
-            Err(e) => failures.push(json!({ "value": v, "error": e.to_string() })),
-        }
-    }
-    let mut bifurcations = Vec::new();
-    for w in points.windows(2) {
-        for what in transition(&w[0].found, &w[1].found) {
-            bifurcations.push(json!({ "between": [w[0].value, w[1].value], "kind": what }));
-        }
-    }
-    // The linear picture: where steady sliding changes stability in the
-    // range (`critical`'s Hopf point), and the branch's point nearest to it.
-    let hopf = crate::commands::critical::locate(&sc.model, &name, lo, hi, 64)
-        .ok()
-        .flatten()
-        .map(|c| {
-            let near = points.iter().min_by(|p, q| {
-                (p.value - c.value)
-                    .abs()
-                    .total_cmp(&(q.value - c.value).abs())
-            });
-            json!({
-                "value": c.value,
-                "freq_hz": c.freq_hz,
-                "nearest_point": near.map(|p| json!({
-                    "value": p.value,
-                    "cycle_freq_hz": 1.0 / p.found.period,
-                    "max_multiplier": p.found.max_multiplier,
-                })),
-            })
-        });
-    write_csv(&name, &names, &points, &stage.path("branch.csv"))?;
-    draw(&sc, &name, &points, &stage)?;
-    let doc = json!({
-        "param": name,
-        "points": points.iter().map(|p| {
-            let mut v = p.found.to_json();
-            v["value"] = json!(p.value);
-            v
-        }).collect::<Vec<_>>(),
-        "bifurcations": bifurcations,
-        "failed": failures,
-        "hopf": hopf,
-        "scenario": sc.to_json(),
-    });
+    let br = follow(&sc, &name, &values, (lo, hi), &NoProgress, &NEVER)?;
+    let points = &br.points;
+    let doc = br.to_json(&name, &sc);
+    let none = Vec::new();
+    let bifurcations = doc["bifurcations"].as_array().unwrap_or(&none);
+    let failures = doc["failed"].as_array().unwrap_or(&none);
+    let hopf = Some(&doc["hopf"]).filter(|h| !h.is_null());
+    write_csv(&name, &names, points, &stage.path("branch.csv"))?;
+    draw(&sc, &name, points, &stage)?;
     crate::output::write_json(&doc, &stage.path("summary.json"))?;
     let dest = stage.commit()?;
     if a.json {
@@ -206,7 +84,7 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
             points.len(),
             n
         );
-        for b in &bifurcations {
+        for b in bifurcations {
             crate::outln!(
                 "  between {name} = {} and {}: {}",
                 b["between"][0],
@@ -223,7 +101,7 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
                 h["nearest_point"]["cycle_freq_hz"].as_f64().unwrap_or(f64::NAN)
             );
         }
-        for f in &failures {
+        for f in failures {
             crate::outln!("  no cycle at {name} = {}: {}", f["value"], f["error"]);
         }
         crate::outln!("output: {}", dest.display());
@@ -231,33 +109,10 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
     Ok(())
 }
 
-/// Newton shooting from the previous point's cycle.
-fn continue_from(
-    sc: &Scenario,
-    prev: Option<&Found>,
-    names: &[String],
-    opts: &squeal_core::cycle::CycleOptions,
-) -> Result<Found, RunError> {
-    let Some(prev) = prev else {
-        return Err(RunError::Numerical("no previous point".into()));
-    };
-    let index = names
-        .iter()
-        .position(|n| *n == prev.section.0)
-        .ok_or_else(|| RunError::Numerical("section lost".into()))?;
-    let section = Section {
-        index,
-        level: prev.section.1,
-    };
-    crate::with_system!(&sc.model, m => {
-        cycle::find(m, &sc.model, &prev.z0, Some((&prev.z0, prev.period, section)), opts, false)
-    }, else => Err(RunError::Numerical("not simulable".into())))
-}
-
 fn write_csv(
     name: &str,
     states: &[String],
-    points: &[Point],
+    points: &[BranchPoint],
     path: &std::path::Path,
 ) -> Result<(), RunError> {
     let io = |e: std::io::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
@@ -291,7 +146,12 @@ fn write_csv(
 
 /// Bifurcation diagram: the phase portrait's velocity amplitude against the
 /// parameter, stable and unstable points as separate series.
-fn draw(sc: &Scenario, name: &str, points: &[Point], stage: &Staging) -> Result<(), RunError> {
+fn draw(
+    sc: &Scenario,
+    name: &str,
+    points: &[BranchPoint],
+    stage: &Staging,
+) -> Result<(), RunError> {
     if points.is_empty() {
         return Ok(());
     }
@@ -315,7 +175,6 @@ fn draw(sc: &Scenario, name: &str, points: &[Point], stage: &Staging) -> Result<
     let panel = Panel::new(&title, name, &y_label)
         .with_series(Series::new("stable", &xs[0], &ys[0]))
         .with_series(Series::new("unstable", &xs[1], &ys[1]));
-    let _ = events_json;
     squeal_plot::line_panels(
         stage.dir().join("branch"),
         &[Format::Png, Format::Svg],
