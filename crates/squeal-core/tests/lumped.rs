@@ -932,3 +932,52 @@ fn folded_field_equals_the_element_loops() {
         }
     }
 }
+
+/// Above 64 dofs Newton's steady-sliding solve runs on faer's LU: a dof
+/// held by nothing (a zero row and column) is refused as singular, as the
+/// small models' nalgebra path does; held, the equilibrium balances every
+/// force (residual at round-off).
+#[test]
+fn large_equilibrium_is_solved_and_a_free_dof_is_refused() {
+    let n = 70;
+    let mut spec = LumpedSpec {
+        dofs: (0..n).map(|i| format!("q{i}")).collect(),
+        masses: (0..n).map(|i| (format!("q{i}"), 1.0)).collect(),
+        ..Default::default()
+    };
+    for i in 1..n {
+        spec.springs.push(spring(
+            &format!("s{i}"),
+            &[(&format!("q{i}"), 1.0), (&format!("q{}", i - 1), -1.0)],
+            1e5 * (1.0 + i as f64 / n as f64),
+            0.1,
+        ));
+    }
+    spec.forces.push(force("f", &[("q5", 1.0)], 3.0));
+    spec.contacts.push(prescribed(
+        "belt",
+        &[("q1", -1.0)],
+        100.0,
+        1.0,
+        FrictionLaw::Coulomb {
+            mu_s: 0.5,
+            mu_k: 0.3,
+        },
+    ));
+    spec.springs
+        .push(spring("ground", &[("q0", 1.0)], 2e5, 0.1));
+    let l = lumped(&spec);
+    let z = l.equilibrium_dyn().unwrap();
+    let f = l.field_dyn(f64::INFINITY, &l.steady_modes(), &z);
+    let scale = 100.0;
+    assert!(
+        f[n..].iter().all(|a| a.abs() <= 1e-9 * scale),
+        "{:?}",
+        &f[n..]
+    );
+    spec.dofs.push("loose".into());
+    spec.masses.push(("loose".into(), 1.0));
+    let l = lumped(&spec);
+    let e = l.equilibrium_dyn().unwrap_err().to_string();
+    assert!(e.contains("singular"), "{e}");
+}
