@@ -60,6 +60,23 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
     })
 }
 
+/// How a study of `model` (a critical value, a map: one eigen-analysis per
+/// point) computes its eigenvalues: `{"method": "dense"}`, or for a lumped
+/// model above `modal.dense_max_dofs` `{"method": "projected",
+/// "dense_max_dofs": …, "modes": …, "cutoff_hz": …}` (the basis is rebuilt
+/// at every point).
+pub fn modal_options_json(model: &AnyModel) -> Value {
+    match model {
+        AnyModel::Lumped(l) if l.modal.projects(l.dof_count()) => json!({
+            "method": "projected",
+            "dense_max_dofs": l.modal.dense_max_dofs,
+            "modes": l.modal.modes,
+            "cutoff_hz": l.modal.cutoff_hz,
+        }),
+        _ => json!({ "method": "dense" }),
+    }
+}
+
 /// How the eigenvalues were computed: `{"method": "dense"}` or
 /// `{"method": "projected", "modes": m, "dofs": n, "basis_max_hz": f}`
 /// (a reduced-basis answer for the modes in that band).

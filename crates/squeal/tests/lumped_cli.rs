@@ -290,6 +290,9 @@ mu_k = 0.3
     let p = json(&squeal(d.path(), &args));
     let z = p["value"].as_f64().unwrap();
     assert!((z - y).abs() <= 1e-9 * y, "projected critical μ {z} vs {y}");
+    assert_eq!(p["modal"]["method"], "projected");
+    assert_eq!(p["modal"]["modes"], 20);
+    assert_eq!(a["modal"]["method"], "dense");
     let mut args = vec!["stability", "big.toml", "--json"];
     args.extend(projected);
     let s = json(&squeal(d.path(), &args));
