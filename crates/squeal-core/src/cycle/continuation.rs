@@ -69,6 +69,71 @@ where
     }
 }
 
+/// A system whose named parameter can be varied: calls `f` with a copy whose
+/// parameter `name` is `value` (checked by the model's own validation).
+pub trait Reparametrise<const N: usize> {
+    /// Call `f` with the system at `name = value`.
+    fn with_param(
+        &self,
+        name: &str,
+        value: f64,
+        f: &mut dyn FnMut(&dyn System<N>),
+    ) -> Result<(), String>;
+}
+
+macro_rules! reparametrise {
+    ($t:ty, $n:literal) => {
+        impl Reparametrise<$n> for $t {
+            fn with_param(
+                &self,
+                name: &str,
+                value: f64,
+                f: &mut dyn FnMut(&dyn System<$n>),
+            ) -> Result<(), String> {
+                use crate::model::Parameters;
+                let mut m = self.clone();
+                m.set(name, value).map_err(|e| e.to_string())?;
+                m.validate().map_err(|e| e.to_string())?;
+                f(&m);
+                Ok(())
+            }
+        }
+    };
+}
+reparametrise!(crate::Belt, 2);
+reparametrise!(crate::DiscPad, 8);
+reparametrise!(crate::Hoffmann, 4);
+
+impl<const N: usize> Reparametrise<N> for crate::model::lumped::Fixed<'_, N> {
+    fn with_param(
+        &self,
+        name: &str,
+        value: f64,
+        f: &mut dyn FnMut(&dyn System<N>),
+    ) -> Result<(), String> {
+        let mut l = self.0.clone();
+        l.set(name, value).map_err(|e| e.to_string())?;
+        l.validate().map_err(|e| e.to_string())?;
+        f(&crate::model::lumped::Fixed::<N>(&l));
+        Ok(())
+    }
+}
+
+/// The family of `model` over its parameter `name`.
+#[derive(Debug, Clone, Copy)]
+pub struct Varied<'a, M: ?Sized> {
+    /// The model at the start.
+    pub model: &'a M,
+    /// The parameter's name.
+    pub name: &'a str,
+}
+
+impl<M: Reparametrise<N> + ?Sized, const N: usize> Family<N> for Varied<'_, M> {
+    fn visit(&self, p: f64, f: &mut dyn FnMut(&dyn System<N>)) -> Result<(), String> {
+        self.model.with_param(self.name, p, f)
+    }
+}
+
 /// Run `f` on the system at `p`.
 fn at<R, const N: usize>(
     fam: &dyn Family<N>,

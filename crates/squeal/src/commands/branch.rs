@@ -1,17 +1,20 @@
 //! `squeal branch [SCENARIO] --param NAME=LO:HI:N --out DIR [--json]`: the
-//! limit cycle followed in one parameter by natural-parameter continuation
-//! (each point's Newton shooting starts from the previous cycle; a point
-//! where that fails is settled afresh by simulation), with the changes of
-//! stability and of the event structure along the branch reported.
+//! limit cycle followed in one parameter by `squeal_core::cycle::continuation`
+//! (pseudo-arclength through folds; grid values where the branch is not
+//! reached are settled afresh by simulation), with the bifurcations along the
+//! branch and its meeting with steady sliding compared with `critical`.
 
-use crate::commands::cycle::{self, events_json, Found};
+use crate::commands::cycle::{self, Found};
 use crate::commands::simulate::resolve;
-use crate::run::{RunError, Staging};
+use crate::run::{self, RunError, Staging};
 use crate::scenario::{InputError, Scenario};
 use crate::ScenarioArgs;
 use clap::Args;
 use serde_json::{json, Value};
-use squeal_core::cycle::Section;
+use squeal_core::cycle::continuation::{
+    branch, Branch, BranchOptions, PointKind, Reparametrise, SegmentEnd, Varied,
+};
+use squeal_core::cycle::{find_cycle, CycleError};
 use squeal_core::EventKind;
 use squeal_plot::{Format, Panel, Series};
 use std::io::{BufWriter, Write};
@@ -54,57 +57,121 @@ fn parse_range(spec: &str) -> Result<(String, f64, f64, usize), InputError> {
     Ok((name.trim().to_string(), lo, hi, n))
 }
 
-/// One point of the branch.
+/// One row of the branch: a grid value or a fold.
 struct Point {
     value: f64,
     found: Found,
+    /// `grid` or `fold`.
+    kind: &'static str,
+    segment: usize,
 }
 
-/// What changes between two neighbouring points: a bifurcation's name.
-fn transition(a: &Found, b: &Found) -> Vec<String> {
-    let mut out = Vec::new();
-    if a.events != b.events {
-        let show = |e: &[u64; 5]| {
-            EventKind::ALL
-                .iter()
-                .filter(|k| e[k.index()] > 0)
-                .map(|k| format!("{} {}", e[k.index()], k.as_str()))
-                .collect::<Vec<_>>()
-                .join(", ")
+/// What the continuation found, independent of the state count.
+struct Outcome {
+    /// Grid and fold rows, segment by segment in the order followed.
+    points: Vec<Point>,
+    /// Every computed point (steps included) for the diagram: segment,
+    /// value, velocity amplitude, stable.
+    curve: Vec<(usize, f64, Vec<f64>, bool)>,
+    bifurcations: Vec<Value>,
+    ends: Vec<Value>,
+    /// Where a segment shrinks onto steady sliding: (value, frequency in Hz).
+    steady: Vec<(f64, f64)>,
+    failures: Vec<Value>,
+}
+
+fn outcome<const N: usize>(b: &Branch<N>, names: &[String]) -> Outcome {
+    let mut points = Vec::new();
+    let mut curve = Vec::new();
+    for p in &b.points {
+        curve.push((
+            p.segment,
+            p.value,
+            p.cycle.amplitude.to_vec(),
+            p.cycle.stable,
+        ));
+        let kind = match p.kind {
+            PointKind::Grid(_) => "grid",
+            PointKind::Fold => "fold",
+            PointKind::Step => continue,
         };
-        out.push(format!(
-            "grazing/sliding: the events per period change ({} → {})",
-            show(&a.events),
-            show(&b.events)
-        ));
+        points.push(Point {
+            value: p.value,
+            found: cycle::found_of(&p.cycle, names.to_vec()),
+            kind,
+            segment: p.segment,
+        });
     }
-    if a.stable != b.stable {
-        // The multiplier that crossed the unit circle: the largest non-trivial
-        // one on the unstable side.
-        let side = if a.stable { b } else { a };
-        let crit = side
-            .multipliers
-            .iter()
-            .filter(|m| !m.2)
-            .max_by(|x, y| x.0.hypot(x.1).total_cmp(&y.0.hypot(y.1)));
-        let kind = match crit {
-            Some(&(re, im, _)) if im.abs() > 1e-9 * re.hypot(im) => "Neimark–Sacker",
-            Some(&(re, _, _)) if re < 0.0 => "period doubling",
-            _ => "fold (a real multiplier through +1)",
+    let bifurcations = b
+        .bifurcations
+        .iter()
+        .map(|x| {
+            json!({
+                "kind": x.kind.as_str(),
+                "between": [x.between.0, x.between.1],
+                "value": x.value,
+                "detail": x.detail,
+            })
+        })
+        .collect();
+    let mut steady = Vec::new();
+    let ends = b
+        .ends
+        .iter()
+        .map(|e| match e {
+            SegmentEnd::LeftRange => json!({ "end": "left_range" }),
+            SegmentEnd::Steps => json!({ "end": "steps" }),
+            SegmentEnd::Stalled { value, cause } => {
+                json!({ "end": "stalled", "value": value, "cause": cause })
+            }
+            SegmentEnd::SteadySliding { value, freq_hz } => {
+                steady.push((*value, *freq_hz));
+                json!({ "end": "steady_sliding", "value": value, "freq_hz": freq_hz })
+            }
+        })
+        .collect();
+    let failures = b
+        .failures
+        .iter()
+        .map(|(v, e)| json!({ "value": v, "error": e.to_string() }))
+        .collect();
+    Outcome {
+        points,
+        curve,
+        bifurcations,
+        ends,
+        steady,
+        failures,
+    }
+}
+
+/// Follow the branch of `sc`'s cycle over `values` of `name`.
+fn follow(
+    sc: &Scenario,
+    name: &str,
+    values: &[f64],
+    opts: &squeal_core::cycle::CycleOptions,
+) -> Result<Outcome, RunError> {
+    let names = sc.model.state_names();
+    let bopts = BranchOptions {
+        cycle: *opts,
+        ..BranchOptions::default()
+    };
+    crate::with_system!(&sc.model, m => {
+        let family = Varied { model: m, name };
+        let mut settle = |v: f64| {
+            let mut out = Err(CycleError::Bad(format!("{name} = {v}: no system")));
+            m.with_param(name, v, &mut |sys| {
+                out = run::initial_of(sys, sc)
+                    .map_err(|e| CycleError::Bad(e.to_string()))
+                    .and_then(|z0| find_cycle(sys, 0.0, z0, opts));
+            })
+            .map_err(CycleError::Bad)?;
+            out
         };
-        out.push(format!(
-            "{kind}: stability {} → {}",
-            if a.stable { "stable" } else { "unstable" },
-            if b.stable { "stable" } else { "unstable" }
-        ));
-    }
-    if (b.period / a.period - 1.0).abs() > 0.5 {
-        out.push(format!(
-            "the period jumps ({:.6e} → {:.6e} s): another cycle",
-            a.period, b.period
-        ));
-    }
-    out
+        let b = branch(&family, values, &mut settle, &bopts);
+        Ok(outcome(&b, &names))
+    }, else => Err(RunError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))))
 }
 
 /// Run the command.
@@ -136,29 +203,18 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
     let stage = Staging::new(&a.out)?;
     let opts = cycle::options(&sc, 20_000_000, 1000.0);
     let names = sc.model.state_names();
-    let mut points: Vec<Point> = Vec::with_capacity(n);
-    let mut failures: Vec<Value> = Vec::new();
-    for &v in &values {
-        let mut p = sc.clone();
-        p.model
-            .set(&name, v)
-            .map_err(|e| InputError(e.to_string()))?;
-        let prev = points.last().map(|q| &q.found);
-        let found = continue_from(&p, prev, &names, &opts)
-            .or_else(|_| cycle::of_scenario(&p, &opts, false));
-        match found {
-            Ok(f) => points.push(Point { value: v, found: f }),
-            Err(e) => failures.push(json!({ "value": v, "error": e.to_string() })),
-        }
-    }
-    let mut bifurcations = Vec::new();
-    for w in points.windows(2) {
-        for what in transition(&w[0].found, &w[1].found) {
-            bifurcations.push(json!({ "between": [w[0].value, w[1].value], "kind": what }));
-        }
-    }
+    let Outcome {
+        points,
+        curve,
+        bifurcations,
+        ends,
+        steady,
+        failures,
+    } = follow(&sc, &name, &values, &opts)?;
     // The linear picture: where steady sliding changes stability in the
-    // range (`critical`'s Hopf point), and the branch's point nearest to it.
+    // range (`critical`'s Hopf point), the branch's own end on steady
+    // sliding (amplitude → 0, extrapolated in A²) nearest to it, and the
+    // branch's point nearest to it.
     let hopf = crate::commands::critical::locate(&sc.model, &name, lo, hi, 64)
         .ok()
         .flatten()
@@ -168,6 +224,9 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
                     .abs()
                     .total_cmp(&(q.value - c.value).abs())
             });
+            let end = steady
+                .iter()
+                .min_by(|a, b| (a.0 - c.value).abs().total_cmp(&(b.0 - c.value).abs()));
             json!({
                 "value": c.value,
                 "freq_hz": c.freq_hz,
@@ -176,18 +235,28 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
                     "cycle_freq_hz": 1.0 / p.found.period,
                     "max_multiplier": p.found.max_multiplier,
                 })),
+                "branch_end": end.map(|&(v, f)| json!({
+                    "value": v,
+                    "freq_hz": f,
+                    "value_difference": v - c.value,
+                    "freq_difference_hz": f - c.freq_hz,
+                })),
             })
         });
     write_csv(&name, &names, &points, &stage.path("branch.csv"))?;
-    draw(&sc, &name, &points, &stage)?;
+    let hopf_value = hopf.as_ref().and_then(|h| h["value"].as_f64());
+    draw(&sc, &name, &curve, hopf_value, &stage)?;
     let doc = json!({
         "param": name,
         "points": points.iter().map(|p| {
             let mut v = p.found.to_json();
             v["value"] = json!(p.value);
+            v["point"] = json!(p.kind);
+            v["segment"] = json!(p.segment);
             v
         }).collect::<Vec<_>>(),
         "bifurcations": bifurcations,
+        "segments": ends,
         "failed": failures,
         "hopf": hopf,
         "scenario": sc.to_json(),
@@ -201,27 +270,45 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
         );
     } else {
         crate::outln!(
-            "{}: {} of {} points on the branch over {name} = {lo}…{hi}",
+            "{}: {} rows ({} grid values of {n}, {} folds) on the branch over {name} = {lo}…{hi}",
             sc.name,
             points.len(),
-            n
+            points.iter().filter(|p| p.kind == "grid").count(),
+            points.iter().filter(|p| p.kind == "fold").count()
         );
         for b in &bifurcations {
+            let at = match b["value"].as_f64() {
+                Some(v) => format!("at {name} = {v:.9e}"),
+                None => format!(
+                    "between {name} = {} and {}",
+                    b["between"][0], b["between"][1]
+                ),
+            };
             crate::outln!(
-                "  between {name} = {} and {}: {}",
-                b["between"][0],
-                b["between"][1],
-                b["kind"].as_str().unwrap_or("")
+                "  {} {at}: {}",
+                b["kind"].as_str().unwrap_or("").replace('_', " "),
+                b["detail"].as_str().unwrap_or("")
+            );
+        }
+        for &(v, f) in &steady {
+            crate::outln!(
+                "  the branch meets steady sliding at {name} = {v:.9e} ({f:.6} Hz; amplitude → 0, extrapolated)"
             );
         }
         if let Some(h) = &hopf {
             crate::outln!(
-                "  steady sliding changes stability at {name} = {} ({:.3} Hz, `critical`); the nearest cycle, at {}, has {:.3} Hz",
+                "  steady sliding changes stability at {name} = {} ({:.6} Hz, `critical`); the nearest cycle, at {}, has {:.6} Hz",
                 h["value"],
                 h["freq_hz"].as_f64().unwrap_or(f64::NAN),
                 h["nearest_point"]["value"],
                 h["nearest_point"]["cycle_freq_hz"].as_f64().unwrap_or(f64::NAN)
             );
+            if let Some(d) = h["branch_end"]["value_difference"].as_f64() {
+                crate::outln!(
+                    "  the branch's end on steady sliding differs from it by {d:.3e} in {name} and {:.3e} Hz",
+                    h["branch_end"]["freq_difference_hz"].as_f64().unwrap_or(f64::NAN)
+                );
+            }
         }
         for f in &failures {
             crate::outln!("  no cycle at {name} = {}: {}", f["value"], f["error"]);
@@ -229,29 +316,6 @@ pub fn run(a: BranchArgs) -> Result<(), RunError> {
         crate::outln!("output: {}", dest.display());
     }
     Ok(())
-}
-
-/// Newton shooting from the previous point's cycle.
-fn continue_from(
-    sc: &Scenario,
-    prev: Option<&Found>,
-    names: &[String],
-    opts: &squeal_core::cycle::CycleOptions,
-) -> Result<Found, RunError> {
-    let Some(prev) = prev else {
-        return Err(RunError::Numerical("no previous point".into()));
-    };
-    let index = names
-        .iter()
-        .position(|n| *n == prev.section.0)
-        .ok_or_else(|| RunError::Numerical("section lost".into()))?;
-    let section = Section {
-        index,
-        level: prev.section.1,
-    };
-    crate::with_system!(&sc.model, m => {
-        cycle::find(m, &sc.model, &prev.z0, Some((&prev.z0, prev.period, section)), opts, false)
-    }, else => Err(RunError::Numerical("not simulable".into())))
 }
 
 fn write_csv(
@@ -272,6 +336,7 @@ fn write_csv(
             .iter()
             .map(|k| format!("events_{}", k.as_str())),
     );
+    header.push("point".into());
     writeln!(w, "{}", header.join(",")).map_err(io)?;
     for p in points {
         let f = &p.found;
@@ -284,15 +349,23 @@ fn write_csv(
                 .iter()
                 .map(|k| f.events[k.index()].to_string()),
         );
+        row.push(p.kind.to_string());
         writeln!(w, "{}", row.join(",")).map_err(io)?;
     }
     w.flush().map_err(io)
 }
 
 /// Bifurcation diagram: the phase portrait's velocity amplitude against the
-/// parameter, stable and unstable points as separate series.
-fn draw(sc: &Scenario, name: &str, points: &[Point], stage: &Staging) -> Result<(), RunError> {
-    if points.is_empty() {
+/// parameter, every computed point of each segment joined in the order
+/// followed, stable solid and unstable dashed; `critical`'s Hopf point marked.
+fn draw(
+    sc: &Scenario,
+    name: &str,
+    curve: &[(usize, f64, Vec<f64>, bool)],
+    hopf: Option<f64>,
+    stage: &Staging,
+) -> Result<(), RunError> {
+    if curve.is_empty() {
         return Ok(());
     }
     let ch = sc.model.channels();
@@ -300,22 +373,48 @@ fn draw(sc: &Scenario, name: &str, points: &[Point], stage: &Staging) -> Result<
     let Some(k) = names.iter().position(|n| *n == ch.phase.1) else {
         return Ok(());
     };
+    // Two series over the same points: each keeps the pieces of its own
+    // stability (the pieces share their end points so the line is unbroken)
+    // and a NaN breaks it elsewhere and between segments.
     let mut xs = [Vec::new(), Vec::new()];
     let mut ys = [Vec::new(), Vec::new()];
-    for p in points {
-        let s = if p.found.stable { 0 } else { 1 };
-        xs[s].push(p.value);
-        ys[s].push(p.found.amplitude[k]);
-        // A gap between runs of the same stability.
-        xs[1 - s].push(f64::NAN);
-        ys[1 - s].push(f64::NAN);
+    for (i, (seg, v, amp, stable)) in curve.iter().enumerate() {
+        let s = usize::from(!*stable);
+        let prev = i.checked_sub(1).map(|j| &curve[j]).filter(|p| p.0 == *seg);
+        if prev.is_none() {
+            for side in 0..2 {
+                xs[side].push(f64::NAN);
+                ys[side].push(f64::NAN);
+            }
+        }
+        if let Some(p) = prev {
+            if p.3 != *stable {
+                // The change of stability: start this side's piece at the
+                // previous point, end the other side's there.
+                xs[s].push(f64::NAN);
+                ys[s].push(f64::NAN);
+                xs[s].push(p.1);
+                ys[s].push(p.2[k]);
+                xs[1 - s].push(f64::NAN);
+                ys[1 - s].push(f64::NAN);
+            }
+        }
+        xs[s].push(*v);
+        ys[s].push(amp[k]);
     }
     let title = format!("{}: limit cycle branch over {name}", sc.name);
     let y_label = format!("amplitude of {} (m/s)", ch.phase.1);
-    let panel = Panel::new(&title, name, &y_label)
-        .with_series(Series::new("stable", &xs[0], &ys[0]))
-        .with_series(Series::new("unstable", &xs[1], &ys[1]));
-    let _ = events_json;
+    let mut panel = Panel::new(&title, name, &y_label)
+        .with_series(Series::new("stable", &xs[0], &ys[0]).colour(0).with_gaps())
+        .with_series(
+            Series::new("unstable", &xs[1], &ys[1])
+                .colour(0)
+                .dashed(true)
+                .with_gaps(),
+        );
+    if let Some(v) = hopf {
+        panel = panel.with_peak(v, "Hopf point of steady sliding (critical)");
+    }
     squeal_plot::line_panels(
         stage.dir().join("branch"),
         &[Format::Png, Format::Svg],
