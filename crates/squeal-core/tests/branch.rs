@@ -373,3 +373,79 @@ fn period_doubling_of_a_moebius_band() {
     assert_eq!(pd.len(), 1);
     assert!(pd[0].between.0 < 0.0 && pd[0].between.1 > 0.0);
 }
+
+/// Period (mean spacing of upward zeros of `vx_p`) and half peak-to-peak of
+/// `vx_p`, simulated from rest: settled for `t_settle`, then recorded densely.
+fn disc_pad_settled(
+    model: &squeal_core::DiscPad,
+    t_settle: f64,
+    opts: SolverOptions,
+) -> (f64, f64) {
+    let mut sol = squeal_core::Solver::new(model, 0.0, [0.0; 8], t_settle, opts).unwrap();
+    while sol.step().unwrap().is_some() {}
+    let (t0, z0) = (sol.t(), *sol.state());
+    let mut rec = Recorder::<8>::new();
+    simulate(model, t0, z0, t0 + 0.005, 4e6, opts, &mut rec).unwrap();
+    let mut ups = Vec::new();
+    for k in 0..rec.t.len() - 1 {
+        let (a, b) = (rec.z[k][5], rec.z[k + 1][5]);
+        if a < 0.0 && b >= 0.0 {
+            ups.push(rec.t[k] + (rec.t[k + 1] - rec.t[k]) * a / (a - b));
+        }
+    }
+    let m = ups.len() - 1;
+    let (lo, hi) = rec
+        .z
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(l, h), z| (l.min(z[5]), h.max(z[5])));
+    ((ups[m] - ups[0]) / m as f64, 0.5 * (hi - lo))
+}
+
+#[test]
+fn disc_pad_branch_matches_settled_simulations() {
+    // The default brake's reversal cycle over V = 0.5 … 0.6, where the pad's
+    // velocity amplitude is just above V (the reversals are brief): every
+    // grid point against a simulation from rest settled as long as `cycle`
+    // needed there (+ 50 %), period to 1e-6 and amplitude to 1 %.
+    let base = squeal_core::DiscPad::default();
+    let opts = BranchOptions::default();
+    let fam = squeal_core::cycle::continuation::Varied {
+        model: &base,
+        name: "V",
+    };
+    let copts = opts.cycle;
+    let mut settle = |v: f64| {
+        let mut m = base;
+        m.set("V", v).unwrap();
+        find_cycle(&m, 0.0, [0.0; 8], &copts)
+    };
+    let values = grid(0.5, 0.6, 3);
+    let b = branch(&fam, &values, &mut settle, &opts);
+    assert!(b.failures.is_empty(), "{:?}", b.failures);
+    assert!(b.bifurcations.is_empty(), "{:?}", b.bifurcations);
+    let grid_points: Vec<_> = b
+        .points
+        .iter()
+        .filter(|p| matches!(p.kind, PointKind::Grid(_)))
+        .collect();
+    assert_eq!(grid_points.len(), 3);
+    let t_settle = 1.5 * b.points[0].cycle.settle_time;
+    for p in grid_points {
+        let mut m = base;
+        m.set("V", p.value).unwrap();
+        let (t_sim, a_sim) = disc_pad_settled(&m, t_settle, copts.solver);
+        assert!(
+            (p.cycle.period - t_sim).abs() <= 1e-6 * t_sim,
+            "V = {}: period {} vs settled {t_sim}",
+            p.value,
+            p.cycle.period
+        );
+        assert!(
+            (p.cycle.amplitude[5] - a_sim).abs() <= 1e-2 * a_sim,
+            "V = {}: amplitude {} vs settled {a_sim}",
+            p.value,
+            p.cycle.amplitude[5]
+        );
+        assert_eq!(p.cycle.events_per_period[EventKind::Reverse.index()], 2);
+    }
+}

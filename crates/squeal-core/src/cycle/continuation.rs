@@ -15,19 +15,26 @@
 //! difference through the event-driven flow). The branch is a curve in the
 //! `N + 2` unknowns, followed in scaled coordinates (states by the orbit's
 //! amplitude as in the module [`super`], the period by the current period,
-//! the parameter by the grid spacing). Its tangent `t` solves
-//! `[∂G/∂X; t_prevᵀ] t = e_{N+2}` (Keller 1977; Allgower & Georg 1990, §2.1).
+//! the parameter by the grid spacing), rescaled at every point.
 //!
 //! # Steps
 //!
-//! Where the branch is parameter-dominated (`|t_p| ≥ ½`) a step fixes the
-//! parameter at the next grid value (natural-parameter correction with the
-//! tangent predictor, so grid rows cost nothing extra). Elsewhere — near a
-//! fold, where `p` turns back — it is a pseudo-arclength step: predictor
-//! `X̂ = X + Δs t`, corrector Newton on `G = 0, tᵀ(X − X̂) = 0`, and the grid
-//! values it passes are computed afterwards with the parameter fixed. A fold
-//! is where `t_p` changes sign; it is located by secant iterations on `t_p`
-//! along the chord between the two points around it and added as a point.
+//! The direction of travel is the secant through the last two points
+//! (Allgower & Georg 1990, §2.2; the Jacobian's null vector is ill-conditioned
+//! where slowly decaying modes put multipliers a hair below 1, as in the
+//! disc–pad). Where the branch is parameter-dominated (`|t_p| ≥ ½`) a step
+//! fixes the parameter at the next grid value (natural-parameter correction
+//! with the secant predictor, so grid rows cost nothing extra). Elsewhere —
+//! near a fold, where `p` turns back — it is a pseudo-arclength step
+//! (Keller 1977): predictor `X̂ = X + Δs t`, corrector Newton on `G = 0,
+//! tᵀ(X − X̂) = 0`, and the grid values it passed are computed afterwards
+//! with the parameter fixed. A fold is where the parameter turns between
+//! three points; it is located as the extreme of the parabola `p(s)` through
+//! them (chord arclength), corrected on the hyperplane normal to the
+//! interpolated direction, three times, and added as a point. A step may not
+//! shrink the cycle by more than half (Newton's method can fall onto the
+//! equilibrium, which solves the equations with any `T`); a failed step is
+//! retried at half the length.
 //!
 //! # Bifurcations
 //!
@@ -161,7 +168,7 @@ pub struct BranchOptions {
     /// Most Newton iterations of one corrector.
     pub corrector_iterations: usize,
     /// Largest step (scaled arclength; 1 is one grid spacing of a
-    /// parameter-dominated branch).
+    /// parameter-dominated branch: steps stop at every grid value anyway).
     pub max_step: f64,
     /// Smallest step before a segment is given up.
     pub min_step: f64,
@@ -176,7 +183,7 @@ impl Default for BranchOptions {
             cycle: CycleOptions::default(),
             max_steps: 2000,
             corrector_iterations: 8,
-            max_step: 1.0,
+            max_step: 2.0,
             min_step: 1e-3,
             amplitude_floor: 1e-2,
         }
@@ -322,37 +329,12 @@ impl<const N: usize> Scale<N> {
         }
         (z, x[N] * self.t, x[N + 1] * self.p)
     }
-    /// Unscaled direction `(dz, dT, dp)` of a scaled vector.
-    fn unscale_dir(&self, t: &DVector<f64>) -> DVector<f64> {
-        DVector::from_fn(N + 2, |i, _| match i {
-            i if i < N => t[i] * self.s[i],
-            i if i == N => t[i] * self.t,
-            _ => t[i] * self.p,
-        })
-    }
-    /// Scaled unit direction of an unscaled one.
-    fn scale_dir(&self, d: &DVector<f64>) -> DVector<f64> {
-        let v = DVector::from_fn(N + 2, |i, _| match i {
-            i if i < N => d[i] / self.s[i],
-            i if i == N => d[i] / self.t,
-            _ => d[i] / self.p,
-        });
-        let n = v.norm();
-        if n > 0.0 {
-            v / n
-        } else {
-            v
-        }
-    }
 }
 
-/// A converged point with its Jacobian and unscaled tangent.
+/// A converged point.
 struct Solved<const N: usize> {
     cycle: Cycle<N>,
     p: f64,
-    scale: Scale<N>,
-    /// `∂G/∂X` (scaled, `(N + 1) × (N + 2)`).
-    jac: DMatrix<f64>,
 }
 
 /// Newton's method on `G(X) = 0`, `rowᵀ (X − X̂) = 0` from the predictor
@@ -369,6 +351,7 @@ fn correct<const N: usize>(
     let mut x = pred.clone();
     let s = scale.s;
     let mut dphi_dp: Option<DVector<f64>> = None;
+    let mut last_res = f64::INFINITY;
     for iteration in 0..=opts.corrector_iterations {
         let (mut z, t, p) = scale.unx(&x);
         z[section.index] = section.level;
@@ -390,6 +373,11 @@ fn correct<const N: usize>(
             .fold(0.0, f64::max);
         // ∂φ_T/∂p by a forward difference (once per corrector: Newton's
         // method needs it only approximately, the residual is exact).
+        // With the parameter fixed (row e_p) its column does not matter.
+        let fixed_p = row[N + 1] == 1.0;
+        if dphi_dp.is_none() && fixed_p {
+            dphi_dp = Some(DVector::zeros(N));
+        }
         if dphi_dp.is_none() {
             let h = 1e-6 * scale.p;
             let end = at(fam, p + h, |sys| {
@@ -414,13 +402,15 @@ fn correct<const N: usize>(
             let cycle = at(fam, p, |sys| {
                 finish(sys, z, t, section, s, res, iteration, flow)
             })??;
-            return Ok(Solved {
-                cycle,
-                p,
-                scale: *scale,
-                jac,
-            });
+            return Ok(Solved { cycle, p });
         }
+        // Diverging: give up early (the step is retried shorter).
+        if iteration >= 2 && res > 2.0 * last_res {
+            return Err(CycleError::Shooting(format!(
+                "the corrector diverges (residual {last_res:.3e} → {res:.3e}) at parameter {p}"
+            )));
+        }
+        last_res = res;
         if iteration == opts.corrector_iterations {
             return Err(CycleError::Shooting(format!(
                 "residual {res:.3e} after {iteration} corrector iterations at parameter {p}"
@@ -453,24 +443,6 @@ fn correct<const N: usize>(
         x += dx * lambda;
     }
     unreachable!("the loop returns")
-}
-
-/// The unit tangent (scaled by `sol.scale`) oriented along `prev` (scaled too).
-fn tangent<const N: usize>(sol: &Solved<N>, prev: &DVector<f64>) -> Option<DVector<f64>> {
-    let mut a = DMatrix::<f64>::zeros(N + 2, N + 2);
-    a.view_mut((0, 0), (N + 1, N + 2)).copy_from(&sol.jac);
-    for j in 0..N + 2 {
-        a[(N + 1, j)] = prev[j];
-    }
-    let mut b = DVector::<f64>::zeros(N + 2);
-    b[N + 1] = 1.0;
-    let t = a.lu().solve(&b)?;
-    let n = t.norm();
-    if !(n.is_finite() && n > 0.0) {
-        return None;
-    }
-    let t = t / n;
-    Some(if t.dot(prev) < 0.0 { -t } else { t })
 }
 
 fn velocity_amplitude<const N: usize>(c: &Cycle<N>) -> f64 {
@@ -567,20 +539,24 @@ fn follow<const N: usize>(
     let section = cycle.section;
     let first = points.len();
     let p0 = grid[i];
-    // The first point's Jacobian: a corrector from the cycle itself with the
-    // parameter fixed (converges at once).
+    let settle_time = cycle.settle_time;
+    // The first point: a corrector from the cycle itself with the parameter
+    // fixed (converges at once).
     let scale = Scale::of(&cycle, &opts.cycle, dp);
     let x0 = scale.x(&cycle.z0, cycle.period, p0);
     let e_p = DVector::from_fn(N + 2, |k, _| if k == N + 1 { 1.0 } else { 0.0 });
     let mut cur = match correct(fam, section, &scale, &x0, &e_p, opts) {
-        Ok(s) => s,
+        Ok(mut s) => {
+            s.cycle.settle_time = settle_time;
+            s
+        }
         Err(e) => {
             points.push(BranchPoint {
                 value: p0,
                 cycle,
                 kind: PointKind::Grid(i),
                 segment,
-                slope: 0.0,
+                slope: 1.0,
             });
             return SegmentEnd::Stalled {
                 value: p0,
@@ -588,36 +564,39 @@ fn follow<const N: usize>(
             };
         }
     };
-    let Some(mut tan) = tangent(&cur, &e_p) else {
-        points.push(BranchPoint {
-            value: p0,
-            cycle: cur.cycle,
-            kind: PointKind::Grid(i),
-            segment,
-            slope: 0.0,
-        });
-        return SegmentEnd::Stalled {
-            value: p0,
-            cause: "no tangent to the branch (singular extended Jacobian)".into(),
-        };
-    };
     points.push(BranchPoint {
         value: p0,
         cycle: cur.cycle.clone(),
         kind: PointKind::Grid(i),
         segment,
-        slope: tan[N + 1],
+        slope: 1.0,
     });
+    // The previous point (unscaled z, T, p): the secant through it and the
+    // current one is the direction of travel (upwards in p at the start).
+    let mut prev: Option<([f64; N], f64, f64)> = None;
     let mut a_max = velocity_amplitude(&cur.cycle);
-    let mut ds = 0.5 * opts.max_step;
+    // The first step has no secant to predict with: short.
+    let mut ds = 0.0625 * opts.max_step;
     for _ in 0..opts.max_steps {
-        // Rescale to the current point; the tangent goes along.
+        // Scaled to the current point.
         let scale = Scale::of(&cur.cycle, &opts.cycle, dp);
-        let t_here = scale.scale_dir(&cur.scale.unscale_dir(&tan));
         let x = scale.x(&cur.cycle.z0, cur.cycle.period, cur.p);
+        let t_here = match prev {
+            Some((z, t, p)) => {
+                let d = &x - scale.x(&z, t, p);
+                let n = d.norm();
+                if n > 0.0 {
+                    d / n
+                } else {
+                    e_p.clone()
+                }
+            }
+            None => e_p.clone(),
+        };
         let tp = t_here[N + 1];
         let step = if tp.abs() >= 0.5 {
-            // Parameter-dominated: to the next grid value, at most ds.
+            // Parameter-dominated: to the next grid value, at most ds, with
+            // the parameter fixed (the secant predicts the rest).
             let dir = tp.signum();
             let next = grid
                 .iter()
@@ -641,6 +620,24 @@ fn follow<const N: usize>(
             let pred = &x + &t_here * ds;
             correct(fam, section, &scale, &pred, &t_here, opts).map(|s| (s, None, ds))
         };
+        // A step may not shrink the cycle by more than half: near an
+        // equilibrium every `(z*, T)` solves the equations, and Newton's
+        // method can fall onto it; a genuine approach to a Hopf point is
+        // followed in smaller steps.
+        let step = step.and_then(|v| {
+            let (a0, a1) = (
+                velocity_amplitude(&cur.cycle),
+                velocity_amplitude(&v.0.cycle),
+            );
+            if a1 < 0.5 * a0 {
+                Err(CycleError::Shooting(format!(
+                    "the cycle collapsed in one step (amplitude {a0:.3e} → {a1:.3e}) at parameter {}",
+                    v.0.p
+                )))
+            } else {
+                Ok(v)
+            }
+        });
         let (next, grid_index, used) = match step {
             Ok(v) => v,
             Err(e) => {
@@ -654,27 +651,27 @@ fn follow<const N: usize>(
                 continue;
             }
         };
-        let Some(t_next) = tangent(&next, &t_here) else {
-            return SegmentEnd::Stalled {
-                value: next.p,
-                cause: "no tangent to the branch (singular extended Jacobian)".into(),
-            };
-        };
+        // The step grows after an easy corrector (a step cut short by a grid
+        // value counts as the full allowed one), shrinks after a hard one.
         let iters = next.cycle.iterations;
-        ds = if iters <= 2 {
-            (used * 1.5).min(opts.max_step)
-        } else if iters >= 5 {
-            (used * 0.6).max(opts.min_step)
+        let base = if grid_index.is_some() {
+            ds.max(used)
         } else {
-            used.min(opts.max_step)
+            used
+        };
+        ds = if iters <= 2 {
+            (base * 1.5).min(opts.max_step)
+        } else if iters >= 5 {
+            (base * 0.6).max(opts.min_step)
+        } else {
+            base.min(opts.max_step)
         };
         let inside = next.p >= lo - 1e-9 * dp && next.p <= hi + 1e-9 * dp;
+        let xb = scale.x(&next.cycle.z0, next.cycle.period, next.p);
         // Grid values passed over by an arclength step: corrected with the
         // parameter fixed, from the chord.
         if grid_index.is_none() {
             let (pa, pb) = (cur.p, next.p);
-            let xa = x.clone();
-            let xb = scale.x(&next.cycle.z0, next.cycle.period, next.p);
             let mut passed: Vec<(usize, f64)> = grid
                 .iter()
                 .enumerate()
@@ -686,41 +683,40 @@ fn follow<const N: usize>(
                 .collect();
             passed.sort_by(|a, b| a.1.total_cmp(&b.1));
             for (k, th) in passed {
-                let g = &grid[k];
-                let mut pred = &xa + (&xb - &xa) * th;
-                pred[N + 1] = g / dp;
+                let mut pred = &x + (&xb - &x) * th;
+                pred[N + 1] = grid[k] / dp;
                 if let Ok(s) = correct(fam, section, &scale, &pred, &e_p, opts) {
                     covered[k] = true;
-                    let slope = tangent(&s, &t_here).map(|t| t[N + 1]).unwrap_or(0.0);
                     points.push(BranchPoint {
-                        value: *g,
+                        value: grid[k],
                         cycle: s.cycle,
                         kind: PointKind::Grid(k),
                         segment,
-                        slope,
+                        slope: (pb - pa).signum() * tp.abs(),
                     });
                 }
             }
         }
-        // A fold: the parameter turned between cur and next (not where the
+        // A fold: the parameter turned at the current point (not where the
         // cycle has shrunk onto the equilibrium: at a Hopf point p − p_H ∝ A²
         // turns too).
         let small = 0.05 * a_max;
-        if tan[N + 1] * t_next[N + 1] < 0.0
-            && velocity_amplitude(&cur.cycle) > small
-            && velocity_amplitude(&next.cycle) > small
-        {
-            if let Some(fold) = locate_fold(fam, section, &scale, &x, &t_here, &next, &t_next, opts)
+        if let Some((zp, tp_, pp)) = prev {
+            if (next.p - cur.p) * (cur.p - pp) < 0.0
+                && velocity_amplitude(&cur.cycle) > small
+                && velocity_amplitude(&next.cycle) > small
             {
-                let (f, slope) = fold;
-                if f.p >= lo - 1e-9 * dp && f.p <= hi + 1e-9 * dp {
-                    points.push(BranchPoint {
-                        value: f.p,
-                        cycle: f.cycle,
-                        kind: PointKind::Fold,
-                        segment,
-                        slope,
-                    });
+                let xa = scale.x(&zp, tp_, pp);
+                if let Some(f) = locate_fold(fam, section, &scale, [&xa, &x, &xb], opts) {
+                    if f.p >= lo - 1e-9 * dp && f.p <= hi + 1e-9 * dp {
+                        points.push(BranchPoint {
+                            value: f.p,
+                            cycle: f.cycle,
+                            kind: PointKind::Fold,
+                            segment,
+                            slope: 0.0,
+                        });
+                    }
                 }
             }
         }
@@ -730,17 +726,19 @@ fn follow<const N: usize>(
         if let Some(k) = grid_index {
             covered[k] = true;
         }
+        let d = &xb - &x;
+        let slope = d[N + 1] / d.norm().max(f64::MIN_POSITIVE);
         points.push(BranchPoint {
             value: grid_index.map_or(next.p, |k| grid[k]),
             cycle: next.cycle.clone(),
             kind: grid_index.map_or(PointKind::Step, PointKind::Grid),
             segment,
-            slope: t_next[N + 1],
+            slope,
         });
         let a = velocity_amplitude(&next.cycle);
         a_max = a_max.max(a);
+        prev = Some((cur.cycle.z0, cur.cycle.period, cur.p));
         cur = next;
-        tan = t_next;
         if a < opts.amplitude_floor * a_max {
             let seg = &points[first..];
             return match steady_sliding_estimate(seg) {
@@ -755,50 +753,82 @@ fn follow<const N: usize>(
     SegmentEnd::Steps
 }
 
-/// Secant iterations on `t_p` along the chord from `x` (tangent `ta`) to
-/// `b` (tangent `tb`): the fold point and its slope.
-#[allow(clippy::too_many_arguments)]
+/// The fold near three points `x` (scaled, in the order followed) whose
+/// parameter turns at the middle one: parabolas through the fold's estimate
+/// and its neighbours, three times.
 fn locate_fold<const N: usize>(
     fam: &dyn Family<N>,
     section: Section,
     scale: &Scale<N>,
-    x: &DVector<f64>,
-    ta: &DVector<f64>,
-    b: &Solved<N>,
-    tb: &DVector<f64>,
+    x: [&DVector<f64>; 3],
     opts: &BranchOptions,
-) -> Option<(Solved<N>, f64)> {
-    let xb = scale.x(&b.cycle.z0, b.cycle.period, b.p);
-    let chord = &xb - x;
-    let len = chord.norm();
-    if len == 0.0 {
-        return None;
-    }
-    let dir = &chord / len;
-    let (mut sa, mut fa) = (0.0, ta[N + 1]);
-    let (mut sb, mut fb) = (1.0, tb[N + 1]);
-    let mut best: Option<(Solved<N>, f64)> = None;
+) -> Option<Solved<N>> {
+    let mut pts = [x[0].clone(), x[1].clone(), x[2].clone()];
+    let mut best = None;
     for _ in 0..3 {
-        let th = sa + (sb - sa) * fa / (fa - fb);
-        if !(th > 0.0 && th < 1.0) {
+        let Some((f, before_middle)) =
+            fold_once(fam, section, scale, [&pts[0], &pts[1], &pts[2]], opts)
+        else {
             break;
-        }
-        let pred = x + &chord * th;
-        let s = correct(fam, section, scale, &pred, &dir, opts).ok()?;
-        let t = tangent(&s, &dir)?;
-        let f = t[N + 1];
-        let done = f.abs() <= 1e-3;
-        if f * fa > 0.0 {
-            (sa, fa) = (th, f);
+        };
+        let xf = scale.x(&f.cycle.z0, f.cycle.period, f.p);
+        pts = if before_middle {
+            [pts[0].clone(), xf, pts[1].clone()]
         } else {
-            (sb, fb) = (th, f);
-        }
-        best = Some((s, f));
-        if done {
-            break;
-        }
+            [pts[1].clone(), xf, pts[2].clone()]
+        };
+        best = Some(f);
     }
     best
+}
+
+/// One parabola: the extreme of `p(s)` through the three points (chord
+/// arclength `s`), corrected on the hyperplane through the interpolated point
+/// normal to the interpolated direction; whether it lies before the middle one.
+fn fold_once<const N: usize>(
+    fam: &dyn Family<N>,
+    section: Section,
+    scale: &Scale<N>,
+    x: [&DVector<f64>; 3],
+    opts: &BranchOptions,
+) -> Option<(Solved<N>, bool)> {
+    let s1 = (x[1] - x[0]).norm();
+    let s2 = s1 + (x[2] - x[1]).norm();
+    let s = [0.0, s1, s2];
+    // Lagrange basis and its derivative at t.
+    let basis = |t: f64| -> ([f64; 3], [f64; 3]) {
+        let mut l = [0.0; 3];
+        let mut dl = [0.0; 3];
+        for i in 0..3 {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            let den = (s[i] - s[j]) * (s[i] - s[k]);
+            l[i] = (t - s[j]) * (t - s[k]) / den;
+            dl[i] = ((t - s[j]) + (t - s[k])) / den;
+        }
+        (l, dl)
+    };
+    // p(s) = Σ p_i l_i(s) is quadratic: p'(s) = 2a s + b.
+    let p: Vec<f64> = x.iter().map(|v| v[N + 1]).collect();
+    let (_, d0) = basis(0.0);
+    let (_, d1) = basis(1.0);
+    let b = (0..3).map(|i| p[i] * d0[i]).sum::<f64>();
+    let two_a = (0..3).map(|i| p[i] * (d1[i] - d0[i])).sum::<f64>();
+    if two_a == 0.0 {
+        return None;
+    }
+    let t = -b / two_a;
+    if !(t > 0.0 && t < s2) {
+        return None;
+    }
+    let (l, dl) = basis(t);
+    let pred = x[0] * l[0] + x[1] * l[1] + x[2] * l[2];
+    let dir = x[0] * dl[0] + x[1] * dl[1] + x[2] * dl[2];
+    let n = dir.norm();
+    if n == 0.0 {
+        return None;
+    }
+    let f = correct(fam, section, scale, &pred, &(dir / n), opts).ok()?;
+    Some((f, t < s1))
 }
 
 /// Where the amplitude of a segment that shrinks to zero would vanish, and
