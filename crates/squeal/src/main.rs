@@ -6,17 +6,10 @@
 
 mod analysis;
 mod commands;
-mod feasible;
-mod lumped_file;
-mod model;
 mod out;
 mod output;
 mod run;
-mod scenario;
-#[cfg(test)]
-mod scenario_props;
 mod staging;
-mod study;
 
 use clap::{Args, Parser, Subcommand};
 use run::RunError;

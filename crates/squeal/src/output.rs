@@ -1,7 +1,7 @@
 //! Writing a run: `series.csv` (or `series.npy`), `events.csv`, `summary.json`.
 
 use crate::run::{Run, RunError};
-use serde_json::{json, Map, Value};
+use serde_json::Value;
 use squeal_core::EventKind;
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -88,46 +88,6 @@ pub fn write_events_csv(run: &Run, path: &Path) -> Result<(), RunError> {
     res.map_err(|e| io_err(path, e))
 }
 
-/// RMS of each velocity column over the last 20 % of the run.
-pub fn tail_rms(run: &Run, velocity_columns: &[String]) -> Map<String, Value> {
-    let n = run.len();
-    let start = n - n / 5;
-    let mut out = Map::new();
-    for name in velocity_columns {
-        if let Some(col) = run.column(name) {
-            let tail = &col[start.min(n)..];
-            let rms = if tail.is_empty() {
-                0.0
-            } else {
-                (tail.iter().map(|x| x * x).sum::<f64>() / tail.len() as f64).sqrt()
-            };
-            out.insert(name.clone(), json!(rms));
-        }
-    }
-    out
-}
-
-/// The parts of summary.json that describe the integration.
-pub fn integrator_json(run: &Run) -> Value {
-    let s = &run.info.stats;
-    let mut events = Map::new();
-    for k in EventKind::ALL {
-        events.insert(k.as_str().into(), json!(s.event_count(k)));
-    }
-    json!({
-        "integrator": {
-            "method": "DOP853 with dense-output event location",
-            "accepted_steps": s.accepted,
-            "rejected_steps": s.rejected,
-            "rhs_evaluations": s.rhs_evals,
-            "rhs_per_step": if s.accepted > 0 { s.rhs_evals as f64 / s.accepted as f64 } else { 0.0 },
-        },
-        "events": events,
-        "stick_fraction": s.stick_fraction(),
-        "t_final": run.info.t_final,
-    })
-}
-
 /// Write a JSON document, pretty-printed, with a final newline.
 pub fn write_json(value: &Value, path: &Path) -> Result<(), RunError> {
     let mut text = serde_json::to_string_pretty(value).map_err(|e| RunError::Io(e.to_string()))?;
@@ -141,7 +101,7 @@ pub fn write_json(value: &Value, path: &Path) -> Result<(), RunError> {
 /// is the first after the header) and the column.
 fn check_series(dir: &Path, columns: &[String], data: &[Vec<f64>]) -> Result<(), RunError> {
     let bad = |msg: String| {
-        RunError::Input(crate::scenario::InputError(format!(
+        RunError::Input(squeal_study::scenario::InputError(format!(
             "run folder {}: {msg}",
             dir.display()
         )))
@@ -187,7 +147,7 @@ fn check_series(dir: &Path, columns: &[String], data: &[Vec<f64>]) -> Result<(),
 /// `series.csv`, or `series.npy` with the names from `summary.json`) and
 /// its summary.
 pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
-    let bad = |msg: String| RunError::Input(crate::scenario::InputError(msg));
+    let bad = |msg: String| RunError::Input(squeal_study::scenario::InputError(msg));
     if !dir.is_dir() {
         return Err(bad(format!("run folder {}: not a folder", dir.display())));
     }

@@ -17,8 +17,8 @@
 //!   and end it with 130 or 143.
 
 use crate::run::RunError;
-use crate::scenario::InputError;
 use serde_json::{json, Value};
+use squeal_study::scenario::InputError;
 use std::path::{Component, Path, PathBuf};
 use std::sync::Mutex;
 

@@ -3,14 +3,13 @@
 //! of undamped mode coupling), by bracketing and Brent's method.
 
 use crate::commands::simulate::resolve;
-use crate::commands::stability::stability_error;
-use crate::model::AnyModel;
 use crate::run::RunError;
-use crate::scenario::InputError;
 use crate::ScenarioArgs;
 use clap::Args;
 use serde_json::json;
-use squeal_core::stability::{self, CriticalOptions, Crossing, Direction, StabilityError};
+use squeal_core::stability::Direction;
+use squeal_study::critical::locate;
+use squeal_study::scenario::InputError;
 
 /// Arguments of `squeal critical`.
 #[derive(Args, Debug)]
@@ -50,70 +49,6 @@ pub fn parse_interval(spec: &str, flag: &str) -> Result<(String, f64, f64), Inpu
     Ok((name.trim().to_string(), lo, hi))
 }
 
-/// Both ends of a range must be values the parameter may take: the reason
-/// the one that is not cannot, naming it (LO or HI).
-pub fn check_endpoints(model: &AnyModel, name: &str, lo: f64, hi: f64) -> Result<(), String> {
-    for (end, v) in [("LO", lo), ("HI", hi)] {
-        let mut m = model.clone();
-        if let Err(e) = m.set(name, v) {
-            return Err(format!("{end} = {v}: {e}"));
-        }
-    }
-    Ok(())
-}
-
-/// Least stable growth rate and its frequency with `name` set to `value`.
-pub fn growth_at(model: &AnyModel, name: &str, value: f64) -> Result<(f64, f64), StabilityError> {
-    let mut m = model.clone();
-    m.set(name, value)?;
-    m.validate()?;
-    m.max_growth_rate()
-}
-
-/// Locate the crossing of `name` in `[lo, hi]`.
-pub fn locate(
-    model: &AnyModel,
-    name: &str,
-    lo: f64,
-    hi: f64,
-    grid: usize,
-) -> Result<Option<Crossing>, RunError> {
-    if model.get(name).is_none() {
-        return Err(InputError(format!(
-            "--param {name}: unknown parameter for model {}",
-            model.name()
-        ))
-        .into());
-    }
-    check_endpoints(model, name, lo, hi)
-        .map_err(|why| InputError(format!("--param {name}={lo}:{hi}: {why}")))?;
-    let opts = CriticalOptions {
-        grid,
-        ..CriticalOptions::default()
-    };
-    // A range that starts where there is no steady sliding (V = 0, say) starts
-    // just inside, where there is.
-    let mut lo = lo;
-    if let Err(StabilityError::NoSteadySliding(_)) = growth_at(model, name, lo) {
-        let nudged = lo + (hi - lo) * 1e-9;
-        if growth_at(model, name, nudged).is_ok() {
-            lo = nudged;
-        }
-    }
-    let at = |p: f64| {
-        growth_at(model, name, p).map_err(|e| match e {
-            StabilityError::NonFinite { what } => StabilityError::BadInput(format!(
-                "--param {name}={lo}:{hi}: at {name} = {p:e} the {what} at steady sliding is not finite (it overflows)"
-            )),
-            other => other,
-        })
-    };
-    stability::critical(at, lo, hi, &opts).map_err(|e| match e {
-        StabilityError::BadInput(msg) => RunError::Input(InputError(msg)),
-        other => stability_error(other),
-    })
-}
-
 /// Run the command.
 pub fn run(a: CriticalArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
@@ -125,7 +60,7 @@ pub fn run(a: CriticalArgs) -> Result<(), RunError> {
         ))
         .into());
     }
-    let found = locate(&sc.model, &name, lo, hi, a.grid)?;
+    let found = locate(&sc.model, &name, lo, hi, a.grid, &crate::run::NEVER)?;
     if a.json {
         let doc = match &found {
             Some(c) => json!({

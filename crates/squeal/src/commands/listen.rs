@@ -1,11 +1,11 @@
 //! `squeal listen RUN_DIR|SCENARIO [--signal vy_d] [--out squeal.wav] [--float]`:
 //! a velocity as sound, at true pitch, band-limited to the audible range.
 
-use crate::model::channels_for;
 use crate::run::{self, RunError};
-use crate::scenario::InputError;
 use crate::{analysis, output, ScenarioArgs};
 use clap::Args;
+use squeal_study::model::channels_for;
+use squeal_study::scenario::InputError;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `squeal listen`.
@@ -55,7 +55,7 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
             .to_string();
         let validity = summary["scenario"]["validity"]
             .as_f64()
-            .unwrap_or(crate::scenario::VALIDITY);
+            .unwrap_or(squeal_study::scenario::VALIDITY);
         (run, model, validity)
     } else {
         let sc = crate::commands::simulate::resolve_run(&a.scenario, None)?;

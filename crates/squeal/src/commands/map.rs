@@ -2,20 +2,16 @@
 //! stability over a grid of any two parameters, linear (eigenvalues) or
 //! nonlinear (simulation), in parallel and deterministic.
 
-use crate::commands::critical::growth_at;
 use crate::commands::simulate::{resolve, resolve_run};
-use crate::model::AnyModel;
-use crate::run::{progress_bar, RunError, Staging};
-use crate::scenario::{InputError, Scenario};
+use crate::run::{progress_bar, RunError, Staging, NEVER};
 use crate::ScenarioArgs;
 use clap::Args;
-use rayon::prelude::*;
 use serde_json::json;
-use squeal_core::integrate::{Flow, Sink};
-use squeal_core::stability::StabilityError;
-use squeal_core::System;
-use squeal_core::{simulate, EventKind, Mode};
 use squeal_plot::{Colormap, Format, HeatmapSpec};
+use squeal_study::map::{
+    agree, all_points, linear_grid, parse_axis, transient_grid, unit_of, CLASSES,
+};
+use squeal_study::scenario::InputError;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -49,330 +45,6 @@ pub struct MapArgs {
     #[arg(long)]
     json: bool,
 }
-
-/// One grid axis.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Axis {
-    /// Parameter name.
-    pub name: String,
-    /// Grid values.
-    pub values: Vec<f64>,
-    /// Logarithmic spacing.
-    pub log: bool,
-}
-
-/// Parse `NAME=LO:HI:N` into grid values.
-pub fn parse_axis(spec: &str, flag: &str, log: bool, model: &AnyModel) -> Result<Axis, InputError> {
-    let bad = |why: &str| InputError(format!("{flag} {spec}: {why}"));
-    let (name, range) = spec
-        .split_once('=')
-        .ok_or_else(|| bad("expected NAME=LO:HI:N"))?;
-    let parts: Vec<&str> = range.split(':').collect();
-    if parts.len() != 3 {
-        return Err(bad("expected NAME=LO:HI:N"));
-    }
-    let lo: f64 = parts[0]
-        .trim()
-        .parse()
-        .map_err(|_| bad("LO is not a number"))?;
-    let hi: f64 = parts[1]
-        .trim()
-        .parse()
-        .map_err(|_| bad("HI is not a number"))?;
-    let n: usize = parts[2]
-        .trim()
-        .parse()
-        .map_err(|_| bad("N is not a whole number"))?;
-    if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-        return Err(bad("need finite LO < HI"));
-    }
-    if !(2..=4000).contains(&n) {
-        return Err(bad("N must be between 2 and 4000"));
-    }
-    if log && lo <= 0.0 {
-        return Err(bad("a logarithmic axis needs LO > 0"));
-    }
-    let name = name.trim().to_string();
-    if model.get(&name).is_none() {
-        return Err(bad(&format!(
-            "unknown parameter '{name}' for model {}",
-            model.name()
-        )));
-    }
-    crate::commands::critical::check_endpoints(model, &name, lo, hi).map_err(|why| bad(&why))?;
-    let values = (0..n)
-        .map(|i| {
-            let s = i as f64 / (n - 1) as f64;
-            if i + 1 == n {
-                hi
-            } else if log {
-                (lo.ln() + s * (hi.ln() - lo.ln())).exp()
-            } else {
-                lo + s * (hi - lo)
-            }
-        })
-        .collect();
-    Ok(Axis { name, values, log })
-}
-
-/// Unit of a parameter, for axis labels.
-pub fn unit_of(model: &AnyModel, name: &str) -> &'static str {
-    model
-        .keys()
-        .into_iter()
-        .find(|k| k.0 == name)
-        .map(|k| k.1)
-        .unwrap_or("")
-}
-
-/// Linear map: `(σ_max, freq_hz)` per point, row-major over y then x; NaN
-/// where steady sliding does not exist or the parameters are invalid.
-/// A point whose state matrix is not finite is an error (naming the point
-/// and the parameter to blame), not a blank.
-pub fn linear_grid(
-    model: &AnyModel,
-    x: &Axis,
-    y: &Axis,
-    progress: &indicatif::ProgressBar,
-) -> Result<Vec<(f64, f64)>, RunError> {
-    let nx = x.values.len();
-    let points: Vec<Result<(f64, f64), RunError>> = (0..nx * y.values.len())
-        .into_par_iter()
-        .map(|k| {
-            let (i, j) = (k % nx, k / nx);
-            let mut m = model.clone();
-            let r = m
-                .set(&y.name, y.values[j])
-                .map_err(StabilityError::from)
-                .and_then(|_| growth_at(&m, &x.name, x.values[i]));
-            if i == 0 {
-                progress.inc(nx as u64);
-            }
-            match r {
-                Ok(p) => Ok(p),
-                Err(e @ StabilityError::NonFinite { .. }) => {
-                    let _ = m.set(&x.name, x.values[i]);
-                    let why = crate::feasible::stability_failure(&m, e);
-                    Err(RunError::Input(InputError(format!(
-                        "at {} = {:e}, {} = {:e}: {why}",
-                        x.name, x.values[i], y.name, y.values[j]
-                    ))))
-                }
-                Err(_) => Ok((f64::NAN, f64::NAN)),
-            }
-        })
-        .collect();
-    points.into_iter().collect()
-}
-
-/// Outcome of one transient run.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Outcome {
-    /// decays, grows, stick-slip, steady, out-of-range, or failed.
-    pub class: &'static str,
-    /// RMS of the tangential velocity over the last window (m/s).
-    pub rms: f64,
-    /// Fraction of the time in true stick.
-    pub stick_fraction: f64,
-    /// Time the run ended (early once the class is certain).
-    pub t_end: f64,
-}
-
-/// Watches the tangential velocities in windows and stops the run once its
-/// class is certain: decayed by 60 dB from its peak, or stick-slip/reversals
-/// with a steady amplitude (±2 % over three windows).
-struct Watch {
-    idx: Vec<usize>,
-    v_idx: usize,
-    window: f64,
-    next: f64,
-    cur_max: f64,
-    sum2: f64,
-    count: usize,
-    amps: Vec<f64>,
-    last_rms: f64,
-    events_in_window: usize,
-    event_windows: Vec<usize>,
-    peak: f64,
-    decided: Option<&'static str>,
-    /// The scenario's validity bound (m): a position beyond it ends the run `out-of-range`.
-    validity: f64,
-}
-
-impl<const N: usize> Sink<N> for Watch {
-    fn sample(&mut self, t: f64, z: &[f64; N], _mode: Mode) -> Flow {
-        if z[..N / 2]
-            .iter()
-            .any(|q| q.is_nan() || q.abs() > self.validity)
-        {
-            self.decided = Some("out-of-range");
-            return Flow::Stop;
-        }
-        let a = self.idx.iter().map(|&i| z[i].abs()).fold(0.0, f64::max);
-        self.cur_max = self.cur_max.max(a);
-        self.sum2 += z[self.v_idx] * z[self.v_idx];
-        self.count += 1;
-        if t < self.next {
-            return Flow::Continue;
-        }
-        self.next = t + self.window;
-        let amp = self.cur_max;
-        self.last_rms = (self.sum2 / self.count.max(1) as f64).sqrt();
-        self.amps.push(amp);
-        self.event_windows.push(self.events_in_window);
-        self.peak = self.peak.max(amp);
-        (self.cur_max, self.sum2, self.count, self.events_in_window) = (0.0, 0.0, 0, 0);
-        let n = self.amps.len();
-        if n >= 4 {
-            let recent = &self.amps[n - 4..];
-            let steady = recent
-                .windows(2)
-                .all(|w| (w[1] - w[0]).abs() <= 0.02 * w[1].max(1e-300));
-            if self.event_windows[n - 3..].iter().all(|&e| e > 0) && steady {
-                self.decided = Some("stick-slip");
-                return Flow::Stop;
-            }
-            if amp < 1e-3 * self.peak && recent.windows(2).all(|w| w[1] <= w[0]) {
-                self.decided = Some("decays");
-                return Flow::Stop;
-            }
-        }
-        Flow::Continue
-    }
-    fn event(&mut self, _t: f64, kind: EventKind, _z: &[f64; N], _mode: Mode) {
-        if matches!(kind, EventKind::Stick | EventKind::Reverse) {
-            self.events_in_window += 1;
-        }
-    }
-}
-
-fn transient_point<M: System<N>, const N: usize>(
-    model: &M,
-    sc: &Scenario,
-) -> Result<Outcome, String> {
-    let names = model.names();
-    let idx: Vec<usize> = (N / 2..N)
-        .filter(|&i| names[i].starts_with("vx") || names[i] == "v")
-        .collect();
-    let v_idx = *idx.first().ok_or("no tangential velocity")?;
-    let z0 = crate::run::initial_of(model, sc).map_err(|e| e.to_string())?;
-    let window = sc.duration / 50.0;
-    let mut w = Watch {
-        idx,
-        v_idx,
-        window,
-        next: window,
-        cur_max: 0.0,
-        sum2: 0.0,
-        count: 0,
-        amps: Vec::new(),
-        last_rms: 0.0,
-        events_in_window: 0,
-        event_windows: Vec::new(),
-        peak: 0.0,
-        decided: None,
-        validity: sc.validity,
-    };
-    // Each window's peak is taken over the scenario's samples: at 200 kHz it is
-    // within a few % of the envelope, which is all a class needs.
-    let info = simulate(
-        model,
-        0.0,
-        z0,
-        sc.duration,
-        sc.sample_rate,
-        sc.solver,
-        &mut w,
-    )
-    .map_err(|e| e.to_string())?;
-    let class = w.decided.unwrap_or_else(|| {
-        let n = w.amps.len();
-        if n < 6 {
-            return "steady";
-        }
-        // Trend over the second half of the run: ±5 % decides.
-        let (early, late) = (w.amps[n / 2], w.amps[n - 1]);
-        if late > 1.05 * early {
-            "grows"
-        } else if late < 0.95 * early {
-            "decays"
-        } else if w.event_windows[n - 3..].iter().any(|&e| e > 0) {
-            "stick-slip"
-        } else {
-            "steady"
-        }
-    });
-    Ok(Outcome {
-        class,
-        rms: w.last_rms,
-        stick_fraction: info.stats.stick_fraction(),
-        t_end: info.t_final,
-    })
-}
-
-/// Transient map: one simulation per point, stopped early once its class is certain.
-pub fn transient_grid(
-    sc: &Scenario,
-    x: &Axis,
-    y: &Axis,
-    progress: &indicatif::ProgressBar,
-) -> Vec<Outcome> {
-    let nx = x.values.len();
-    (0..nx * y.values.len())
-        .into_par_iter()
-        .map(|k| {
-            let (i, j) = (k % nx, k / nx);
-            let mut s = sc.clone();
-            let r = s
-                .model
-                .set(&x.name, x.values[i])
-                .and_then(|_| s.model.set(&y.name, y.values[j]))
-                .and_then(|_| s.model.validate())
-                .map_err(|e| e.to_string())
-                // Each point gets its own step budget (its stiffness differs).
-                .and_then(|_| crate::feasible::prepare(&mut s).map_err(|e| e.to_string()))
-                .and_then(|_| {
-                    crate::with_system!(&s.model, m => transient_point(m, &s),
-                    else => Err(s.model.check_simulable().err().unwrap_or_default()))
-                });
-            progress.inc(1);
-            r.unwrap_or(Outcome {
-                class: "failed",
-                rms: f64::NAN,
-                stick_fraction: f64::NAN,
-                t_end: f64::NAN,
-            })
-        })
-        .collect()
-}
-
-/// Do the linear verdict (σ) and the simulated outcome tell the same story?
-/// `yes` or `no`; `n/a` where there is no linear verdict (no steady sliding)
-/// or no outcome (the run failed). Never empty.
-fn agree(sigma: f64, o: &Outcome) -> &'static str {
-    if !sigma.is_finite() || o.class == "failed" {
-        return "n/a";
-    }
-    let unstable = sigma > 0.0;
-    // A growing, friction-limited, sustained or runaway outcome is what an
-    // unstable equilibrium predicts; decay is what a stable one predicts.
-    let sustained = matches!(o.class, "grows" | "stick-slip" | "steady" | "out-of-range");
-    if unstable == sustained {
-        "yes"
-    } else {
-        "no"
-    }
-}
-
-/// The outcome classes of a transient map, in legend order.
-pub const CLASSES: [&str; 6] = [
-    "decays",
-    "grows",
-    "stick-slip",
-    "steady",
-    "out-of-range",
-    "failed",
-];
 
 /// A colour range for growth rates, symmetric about σ = 0, that a few
 /// extreme points (near the edge of steady sliding σ can reach 1e6 1/s) do
@@ -429,12 +101,13 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
     let stage = Staging::new_as(flag, &dest)?;
     let n = x.values.len() * y.values.len();
     let pb = progress_bar(n as u64, "eigen-analysis");
-    let lin = linear_grid(&sc.model, &x, &y, &pb)?;
-    pb.finish_and_clear();
+    let points = all_points(&x, &y);
+    let lin = linear_grid(&sc.model, &x, &y, &points, &pb, &NEVER)?;
+    squeal_study::Progress::finish(&pb);
     let trans = if a.transient {
         let pb = progress_bar(n as u64, "simulating");
-        let t = transient_grid(&sc, &x, &y, &pb);
-        pb.finish_and_clear();
+        let t = transient_grid(&sc, &x, &y, &points, &pb, &NEVER)?;
+        squeal_study::Progress::finish(&pb);
         Some(t)
     } else {
         None

@@ -1,10 +1,10 @@
 //! `squeal plot RUN_DIR`: redraw the pictures of a saved run without re-simulating.
 
 use crate::analysis;
-use crate::model::channels_for;
 use crate::output;
 use crate::run::RunError;
 use clap::Args;
+use squeal_study::model::channels_for;
 use std::path::PathBuf;
 
 /// Arguments of `squeal plot`.
@@ -30,7 +30,7 @@ pub fn run(a: PlotArgs) -> Result<(), RunError> {
     let channels = channels_for(model);
     let validity = summary["scenario"]["validity"]
         .as_f64()
-        .unwrap_or(crate::scenario::VALIDITY);
+        .unwrap_or(squeal_study::scenario::VALIDITY);
     let an = analysis::analyse(&run, &channels, &settings, validity, a.spectrum.signals());
     // Drawn into a scratch folder first; each file then replaces only a file
     // squeal wrote (or none) in the run folder.

@@ -1,8 +1,8 @@
 //! `squeal scenario list | show NAME`.
 
 use crate::run::RunError;
-use crate::scenario::{InputError, Scenario, BUILTINS};
 use clap::Subcommand;
+use squeal_study::scenario::{InputError, Scenario, BUILTINS};
 
 /// What to do with scenarios.
 #[derive(Subcommand, Debug)]
@@ -24,7 +24,7 @@ pub fn run(cmd: ScenarioCmd) -> Result<(), RunError> {
                 let s = Scenario::builtin(name).expect("listed built-ins exist");
                 crate::outln!("{name:<14} {}", s.description);
             }
-            for (i, s) in crate::scenario::thesis_sets().iter().enumerate() {
+            for (i, s) in squeal_study::scenario::thesis_sets().iter().enumerate() {
                 crate::outln!("thesis-{:02}      {}", i + 1, s.description);
             }
         }

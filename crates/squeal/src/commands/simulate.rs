@@ -1,11 +1,11 @@
 //! `squeal simulate [SCENARIO] [--set NAME=VALUE]... [--duration S] [--out DIR]`.
 
 use crate::run::{self, RunError, Staging};
-use crate::scenario::{InputError, Scenario, Setting};
 use crate::ScenarioArgs;
 use crate::{analysis, output};
 use clap::Args;
 use serde_json::json;
+use squeal_study::scenario::{InputError, Scenario, Source};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -87,22 +87,17 @@ impl SpectrumArgs {
 
 /// Resolve the scenario named on the command line, with its overrides.
 pub fn resolve(args: &ScenarioArgs) -> Result<Scenario, InputError> {
-    crate::scenario::check_set_syntax(&args.sets, &args.scenario)?;
-    let mut sc = Scenario::load(&args.scenario)?;
-    sc.apply_overrides(&args.sets)?;
-    Ok(sc)
+    squeal_study::scenario::resolve(Source::Spec(&args.scenario), &args.sets)
 }
 
 /// Resolve a scenario for a run — with `--duration` if given — and check it
-/// the one way every simulating command does ([`crate::feasible::prepare`]).
+/// the one way every simulating command does ([`squeal_study::feasible::prepare`]).
 pub fn resolve_run(args: &ScenarioArgs, duration: Option<f64>) -> Result<Scenario, RunError> {
-    let mut sc = resolve(args)?;
-    if let Some(d) = duration {
-        sc.apply("duration", &Setting::Number(d))
-            .map_err(|e| InputError(format!("--duration: {}", e.0)))?;
-    }
-    crate::feasible::prepare(&mut sc)?;
-    Ok(sc)
+    Ok(squeal_study::scenario::resolve_run(
+        Source::Spec(&args.scenario),
+        &args.sets,
+        duration,
+    )?)
 }
 
 /// Run the command.
@@ -147,17 +142,6 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         output::write_series_npy(&run, &stage.path("series.npy"))?;
     }
     output::write_events_csv(&run, &stage.path("events.csv"))?;
-    let velocity_names: Vec<String> = {
-        let names = sc.model.state_names();
-        names[names.len() / 2..]
-            .iter()
-            .map(|s| s.to_string())
-            .collect()
-    };
-    let mut summary = output::integrator_json(&run);
-    summary["scenario"] = sc.to_json();
-    summary["columns"] = json!(run.columns);
-    summary["rms"] = json!(output::tail_rms(&run, &velocity_names));
     let channels = sc.model.channels();
     let an = analysis::analyse(
         &run,
@@ -167,11 +151,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         a.spectrum.signals(),
     );
     analysis::write_spectrum_csv(&an, &stage.path("spectrum.csv"))?;
-    summary["spectrum"] = an.spectrum_json();
-    summary["growth_rate"] = an.growth_json();
-    summary["verdict"] = json!(an.verdict.as_str());
-    summary["verdict_detail"] = an.verdict_detail_json();
-    summary["squeal"] = an.squeal_json();
+    let mut summary = analysis::summary_json(&sc, &run, &an);
     if !a.no_plots {
         analysis::draw(&run, &an, &channels, &sc.name, stage.dir(), &plot_settings)?;
     }
@@ -204,7 +184,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
             serde_json::to_string_pretty(&summary).map_err(|e| RunError::Io(e.to_string()))?
         );
     } else {
-        crate::outln!("{}", an.squeal_line(crate::model::coordinate_words));
+        crate::outln!("{}", an.squeal_line(squeal_study::model::coordinate_words));
         print_human(&sc, &run, &summary, &dest);
     }
     if let Some(note) = hearing {

@@ -3,18 +3,15 @@
 //! continuously by shape (`squeal_core::stability::sweep`), written as
 //! `sweep.csv` and drawn as the mode-coupling diagram (`sweep.png/.svg`).
 
-use crate::commands::map::{parse_axis, unit_of};
 use crate::commands::simulate::resolve;
-use crate::model::AnyModel;
-use crate::run::{RunError, Staging};
-use crate::scenario::InputError;
+use crate::run::{RunError, Staging, NEVER};
 use crate::ScenarioArgs;
 use clap::Args;
-use nalgebra::DMatrix;
 use serde_json::json;
-use squeal_core::stability::sweep::{sweep, Sweep, SweepOptions};
-use squeal_core::stability::{state_matrix, Direction, StabilityError};
+use squeal_core::stability::Direction;
 use squeal_plot::{BranchSeries, Format, ModeCouplingSpec};
+use squeal_study::map::{parse_axis, unit_of};
+use squeal_study::sweep::sweep_model;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -34,40 +31,6 @@ pub struct SweepArgs {
     json: bool,
 }
 
-/// The state matrix `A = ∂f/∂z` and equilibrium of any model, as runtime-sized values.
-pub fn model_state_matrix(model: &AnyModel) -> Result<(DMatrix<f64>, Vec<f64>), StabilityError> {
-    crate::with_model!(model, m => {
-        let (z, a) = state_matrix(m)?;
-        let n = z.len();
-        Ok((DMatrix::from_fn(n, n, |i, j| a[i][j]), z.to_vec()))
-    }, lumped l => {
-        let (z, a) = squeal_core::stability::lumped::state_matrix(l)?;
-        Ok((a, z))
-    })
-}
-
-/// Sweep `name` over `values` for any model (built-in or lumped). On
-/// failure, also the parameter value where it happened.
-pub fn sweep_model(
-    model: &AnyModel,
-    name: &str,
-    values: &[f64],
-) -> Result<Sweep, (StabilityError, f64)> {
-    let mut at = f64::NAN;
-    sweep(
-        values,
-        |p| {
-            at = p;
-            let mut m = model.clone();
-            m.set(name, p)?;
-            m.validate()?;
-            model_state_matrix(&m)
-        },
-        &SweepOptions::default(),
-    )
-    .map_err(|e| (e, at))
-}
-
 fn num(x: f64) -> String {
     if x.is_finite() {
         format!("{x:e}")
@@ -85,16 +48,7 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", sc.name)));
     let stage = Staging::new(&dest)?;
-    let sw = sweep_model(&sc.model, &axis.name, &axis.values).map_err(|(e, at)| match e {
-        StabilityError::Param(_) => {
-            RunError::Input(InputError(format!("--param {}: {e}", a.param)))
-        }
-        StabilityError::NoSteadySliding(_) => RunError::Input(InputError(format!(
-            "--param {}: at {} = {at}: {e}",
-            a.param, axis.name
-        ))),
-        other => RunError::Numerical(format!("eigen-analysis at {} = {at}: {other}", axis.name)),
-    })?;
+    let sw = sweep_model(&sc.model, &axis.name, &axis.values, &a.param, &NEVER)?;
     let path = stage.path("sweep.csv");
     let io = |e: std::io::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
     let mut w = std::io::BufWriter::new(std::fs::File::create(&path).map_err(io)?);

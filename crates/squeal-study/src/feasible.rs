@@ -4,8 +4,8 @@
 //! model's fastest mode, and the work an explicit integrator needs for its
 //! stiffest time scale (which also sets the run's step budget).
 
+use crate::error::StudyError;
 use crate::model::AnyModel;
-use crate::run::RunError;
 use crate::scenario::{InputError, Scenario};
 use nalgebra::Complex;
 use squeal_core::integrate::budget::{min_steps, step_budget};
@@ -173,13 +173,26 @@ fn scaling_law(model: &AnyModel) -> String {
     format!(" (|λ| ∝ {})", parts.join(" · "))
 }
 
-/// A stability failure as a command error. A non-finite state matrix or
+/// A stability failure as a study error: bad input (a missing steady
+/// sliding, a bad parameter or interval, a non-finite matrix) or numerical
+/// trouble (the rest).
+pub fn stability_error(e: StabilityError) -> StudyError {
+    match e {
+        StabilityError::NoSteadySliding(_)
+        | StabilityError::Param(_)
+        | StabilityError::NonFinite { .. }
+        | StabilityError::BadInterval { .. } => StudyError::Input(InputError(e.to_string())),
+        other => StudyError::Numerical(other.to_string()),
+    }
+}
+
+/// A stability failure as a study error. A non-finite state matrix or
 /// equilibrium is bad input (exit 2) naming the parameter that causes it
 /// (the one whose default value makes it finite); see
-/// [`crate::commands::stability::stability_error`] for the rest.
-pub fn stability_failure(model: &AnyModel, e: StabilityError) -> RunError {
+/// [`stability_error`] for the rest.
+pub fn stability_failure(model: &AnyModel, e: StabilityError) -> StudyError {
     let StabilityError::NonFinite { what } = e else {
-        return crate::commands::stability::stability_error(e);
+        return stability_error(e);
     };
     let finite = |m: &AnyModel| match scales(m, None) {
         Err(StabilityError::NonFinite { .. }) => 1.0,
@@ -196,14 +209,14 @@ pub fn stability_failure(model: &AnyModel, e: StabilityError) -> RunError {
             "the {what} at steady sliding is not finite (it overflows): check the parameters for extreme values"
         ),
     };
-    RunError::Input(InputError(msg))
+    StudyError::Input(InputError(msg))
 }
 
 /// Check that `sc` can be run, before any work: the series fits in memory,
 /// the sample rate resolves the fastest mode, and the integration needs a
 /// bounded number of steps; then set the run's step budget
 /// (`sc.solver.max_steps`). `what` names the run in messages.
-pub fn prepare(sc: &mut Scenario) -> Result<(), RunError> {
+pub fn prepare(sc: &mut Scenario) -> Result<(), StudyError> {
     sc.validate()?;
     let rows = sc.duration * sc.sample_rate + 2.0;
     let cols = (1 + sc.model.state_names().len() + sc.model.derived_columns().len()) as f64;
@@ -242,7 +255,7 @@ pub fn prepare(sc: &mut Scenario) -> Result<(), RunError> {
     };
     let need = min_steps(lambda, sc.duration, h_max);
     if need > MAX_MIN_STEPS {
-        return Err(RunError::Numerical(stiff_message(
+        return Err(StudyError::Numerical(stiff_message(
             sc,
             scales.as_ref(),
             need,

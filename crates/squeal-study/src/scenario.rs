@@ -286,6 +286,13 @@ impl Scenario {
                 None => InputError(format!("malformed TOML: {msg}")),
             }
         })?;
+        Scenario::from_table_in(&table, base)
+    }
+
+    /// Build a scenario from an already parsed TOML table (the Python
+    /// package's dict), matrix files (lumped models) relative to `base`;
+    /// the same checks and messages as a file.
+    pub fn from_table_in(table: &toml::Table, base: Option<&Path>) -> Result<Scenario, InputError> {
         let model_name = match table.get("model") {
             Some(toml::Value::String(s)) => s.clone(),
             Some(v) => {
@@ -299,7 +306,7 @@ impl Scenario {
         let mut matrices = MatrixFiles::default();
         let lumped = model_name == "lumped";
         let model = if lumped {
-            let (l, files) = crate::lumped_file::parse(&table, base)?;
+            let (l, files) = crate::lumped_file::parse(table, base)?;
             matrices = files;
             AnyModel::Lumped(Box::new(l))
         } else {
@@ -331,7 +338,7 @@ impl Scenario {
                 s.apply("friction", &Setting::Text(law.into()))?;
             }
         }
-        for (key, value) in &table {
+        for (key, value) in table {
             match (key.as_str(), value) {
                 ("model", _) => {}
                 (k, _) if lumped && LUMPED_KEYS.contains(&k) => {}
@@ -1024,4 +1031,50 @@ mod tests {
         let e = refused(&s, "atol_vx_p=-1");
         assert!(e.contains("atol_vx_p"), "{e}");
     }
+}
+
+/// Where a scenario comes from.
+#[derive(Debug, Clone, Copy)]
+pub enum Source<'a> {
+    /// A built-in name or a TOML file path (as the command line takes it).
+    Spec(&'a str),
+    /// TOML text; matrix files relative to the working directory.
+    Toml(&'a str),
+    /// A parsed TOML table (a Python dict); matrix files relative to the
+    /// working directory.
+    Table(&'a toml::Table),
+}
+
+/// Resolve a scenario from its source and `--set KEY=VALUE` overrides
+/// (syntax checked first, then applied, then validated).
+pub fn resolve(source: Source<'_>, sets: &[String]) -> Result<Scenario, InputError> {
+    let label = match source {
+        Source::Spec(spec) => spec,
+        Source::Toml(_) | Source::Table(_) => "scenario",
+    };
+    check_set_syntax(sets, label)?;
+    let mut sc = match source {
+        Source::Spec(spec) => Scenario::load(spec)?,
+        Source::Toml(text) => Scenario::from_toml(text)?,
+        Source::Table(t) => Scenario::from_table_in(t, None)?,
+    };
+    sc.apply_overrides(sets)?;
+    Ok(sc)
+}
+
+/// [`resolve`] for a run — with `duration` if given — checked the one way
+/// every simulating computation is ([`crate::feasible::prepare`]: memory,
+/// sample rate, stiffness, and the step budget).
+pub fn resolve_run(
+    source: Source<'_>,
+    sets: &[String],
+    duration: Option<f64>,
+) -> Result<Scenario, crate::StudyError> {
+    let mut sc = resolve(source, sets)?;
+    if let Some(d) = duration {
+        sc.apply("duration", &Setting::Number(d))
+            .map_err(|e| InputError(format!("--duration: {}", e.0)))?;
+    }
+    crate::feasible::prepare(&mut sc)?;
+    Ok(sc)
 }

@@ -5,7 +5,8 @@
 //! (C5). Each is deterministic: the same model gives the same numbers,
 //! whatever the number of threads.
 
-use crate::run::{self, Run, RunError};
+use crate::error::{Cancel, NoProgress, StudyError};
+use crate::run::{self, Run};
 use crate::scenario::{Scenario, Setting};
 use rayon::prelude::*;
 use squeal_core::model::disc_pad::DiscPad;
@@ -246,7 +247,7 @@ impl StickStats {
     }
 }
 
-fn scenario_with(base: &Scenario, settings: &[(&str, Setting)]) -> Result<Scenario, RunError> {
+fn scenario_with(base: &Scenario, settings: &[(&str, Setting)]) -> Result<Scenario, StudyError> {
     let mut sc = base.clone();
     for (k, v) in settings {
         sc.apply(k, v)?;
@@ -297,15 +298,20 @@ fn tangential(m: &DiscPad) -> Option<(f64, f64, f64)> {
 
 /// Sweep c_px across the pad's Hopf damping: eigenvalues and runs from
 /// steady sliding with the pad and the disc kicked.
-pub fn cpx_sweep(base: &Scenario, factors: &[f64], duration: f64) -> Result<CpxSweep, RunError> {
+pub fn cpx_sweep(
+    base: &Scenario,
+    factors: &[f64],
+    duration: f64,
+    cancel: &Cancel,
+) -> Result<CpxSweep, StudyError> {
     let crate::model::AnyModel::DiscPad(m) = base.model else {
-        return Err(RunError::Numerical(
+        return Err(StudyError::Numerical(
             "the pad-damping sweep needs the disc–pad model".into(),
         ));
     };
     let z = m
         .equilibrium()
-        .map_err(|e| RunError::Numerical(e.to_string()))?;
+        .map_err(|e| StudyError::Numerical(e.to_string()))?;
     let f_y = m.p.k_py * (z[2] - z[3]);
     let c_star = -f_y * m.friction.dmu(m.p.V);
     let kick = (0.2 * m.p.V, 0.01 * m.p.V);
@@ -315,7 +321,7 @@ pub fn cpx_sweep(base: &Scenario, factors: &[f64], duration: f64) -> Result<CpxS
         .filter_map(|mm| tangential(&mm))
         .map(|t| ((t.0 - disc0) / disc0).abs())
         .fold(0.0, f64::max);
-    let points: Result<Vec<CpxPoint>, RunError> = factors
+    let points: Result<Vec<CpxPoint>, StudyError> = factors
         .par_iter()
         .map(|&k| {
             let c_px = k * c_star;
@@ -334,7 +340,7 @@ pub fn cpx_sweep(base: &Scenario, factors: &[f64], duration: f64) -> Result<CpxS
             };
             let (sigma_disc, sigma_pad, f_disc) =
                 tangential(&mm).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
-            let r: Run = run::run_with(&sc, &indicatif::ProgressBar::hidden())?;
+            let r: Run = run::run(&sc, &NoProgress, cancel)?;
             let saturated_at = r
                 .events
                 .iter()
@@ -396,7 +402,7 @@ pub struct AboveUc {
 
 /// Kick the undamped brake (c_dx = c_px = 0) at V = 2·U_c far beyond the
 /// disc speed (pad 1.5·V, disc 0.5·V) and follow it.
-pub fn above_uc(base: &Scenario, duration: f64) -> Result<AboveUc, RunError> {
+pub fn above_uc(base: &Scenario, duration: f64, cancel: &Cancel) -> Result<AboveUc, StudyError> {
     let uc = base.model.get("Uc").unwrap_or(50.0 / 3.0);
     let v = 2.0 * uc;
     let kick = (1.5 * v, 0.5 * v);
@@ -413,7 +419,7 @@ pub fn above_uc(base: &Scenario, duration: f64) -> Result<AboveUc, RunError> {
         ],
     )?;
     let crate::model::AnyModel::DiscPad(m) = sc.model else {
-        return Err(RunError::Numerical(
+        return Err(StudyError::Numerical(
             "the perturbation study needs the disc–pad model".into(),
         ));
     };
@@ -423,7 +429,7 @@ pub fn above_uc(base: &Scenario, duration: f64) -> Result<AboveUc, RunError> {
         find("x_d").unwrap_or(Complex::new(f64::NAN, f64::NAN)),
         find("x_p").unwrap_or(Complex::new(f64::NAN, f64::NAN)),
     );
-    let r = run::run_with(&sc, &indicatif::ProgressBar::hidden())?;
+    let r = run::run(&sc, &NoProgress, cancel)?;
     let rate = |col: &str, l: Complex<f64>| {
         let b = demodulate(
             r.column(col).unwrap_or(&[]),

@@ -1,0 +1,31 @@
+//! `squeal-study`: everything squeal computes above the engine — scenarios
+//! (built-ins, TOML, `--set` overrides), runs, feasibility checks, and the
+//! studies (stability, maps, critical values, sweeps, cycles, branches, the
+//! thesis reproduction) — shared by the command line and the Python package.
+//!
+//! No files are written, no clocks read and nothing printed here (a scenario's
+//! own Matrix Market inputs are read). Long computations take a [`Cancel`]
+//! token and report to a [`Progress`]; failures are [`StudyError`]s.
+
+pub mod analysis;
+pub mod branch;
+pub mod critical;
+pub mod cycle;
+pub mod error;
+pub mod feasible;
+pub mod lumped_file;
+pub mod map;
+pub mod model;
+pub mod reproduce;
+pub mod run;
+pub mod scenario;
+#[cfg(test)]
+mod scenario_props;
+pub mod stability;
+pub mod study;
+pub mod sweep;
+
+pub use error::{Cancel, NoProgress, Progress, StudyError};
+pub use model::AnyModel;
+pub use run::Run;
+pub use scenario::{InputError, Scenario, Setting};

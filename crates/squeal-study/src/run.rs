@@ -1,0 +1,208 @@
+//! Running a scenario: integrate and collect columns and events.
+
+use crate::error::{Cancel, Progress, StudyError};
+use crate::model::observe_all;
+use crate::model::AnyModel;
+use crate::scenario::{InputError, Scenario};
+use squeal_core::initial::initial_state;
+use squeal_core::integrate::{Flow, Sink};
+use squeal_core::model::{Modes, Observables};
+use squeal_core::{simulate, EventKind, Mode, RunInfo, System};
+
+/// How many samples pass between two looks at the [`Cancel`] token.
+const CANCEL_EVERY: u32 = 1024;
+
+/// A finished run: uniformly sampled columns and the event list.
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// Column names: `t`, the states, then the model's derived columns.
+    pub columns: Vec<String>,
+    /// Column data, same order as `columns`.
+    pub data: Vec<Vec<f64>>,
+    /// Events `(t, kind)` in order.
+    pub events: Vec<(f64, EventKind)>,
+    /// The contact of each event (index into `contact_names`).
+    pub event_contacts: Vec<usize>,
+    /// Names of the model's contacts.
+    pub contact_names: Vec<String>,
+    /// Integrator statistics and end time.
+    pub info: RunInfo,
+    /// Wall time of the integration (s): measured by the caller (the
+    /// library reads no clock), 0 until then.
+    pub integrate_s: f64,
+    /// Output sample rate (Hz).
+    pub sample_rate: f64,
+}
+
+impl Run {
+    /// The column called `name`.
+    pub fn column(&self, name: &str) -> Option<&[f64]> {
+        self.columns
+            .iter()
+            .position(|c| c == name)
+            .map(|i| self.data[i].as_slice())
+    }
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.data.first().map_or(0, Vec::len)
+    }
+    /// Whether the run has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+struct Collect<'a, M: ?Sized> {
+    model: &'a M,
+    any: &'a AnyModel,
+    data: Vec<Vec<f64>>,
+    derived: Vec<f64>,
+    obs: Vec<Observables>,
+    events: Vec<(f64, EventKind)>,
+    event_contacts: Vec<usize>,
+    progress: &'a dyn Progress,
+    cancel: &'a Cancel,
+    until_check: u32,
+    t_end: f64,
+    next_tick: f64,
+    ticks: u64,
+}
+
+impl<M: System<N> + ?Sized, const N: usize> Sink<N> for Collect<'_, M> {
+    fn sample(&mut self, t: f64, z: &[f64; N], mode: Mode) -> Flow {
+        self.sample_modes(t, z, &Modes::single(mode))
+    }
+    fn sample_modes(&mut self, t: f64, z: &[f64; N], modes: &Modes) -> Flow {
+        self.data[0].push(t);
+        for i in 0..N {
+            self.data[1 + i].push(z[i]);
+        }
+        observe_all(self.model, t, modes, z, &mut self.obs);
+        self.any.derived_values(&self.obs, modes, &mut self.derived);
+        for (j, v) in self.derived.iter().enumerate() {
+            self.data[1 + N + j].push(*v);
+        }
+        if t >= self.next_tick {
+            let ticks = ((1000.0 * t / self.t_end) as u64).max(self.ticks);
+            self.progress.inc(ticks - self.ticks);
+            self.ticks = ticks;
+            self.next_tick = t + self.t_end / 200.0;
+        }
+        self.until_check -= 1;
+        if self.until_check == 0 {
+            self.until_check = CANCEL_EVERY;
+            if self.cancel.is_cancelled() {
+                return Flow::Stop;
+            }
+        }
+        Flow::Continue
+    }
+    fn event(&mut self, t: f64, kind: EventKind, _z: &[f64; N], _mode: Mode) {
+        self.events.push((t, kind));
+        self.event_contacts.push(0);
+    }
+    fn contact_event(
+        &mut self,
+        t: f64,
+        kind: EventKind,
+        contact: usize,
+        _z: &[f64; N],
+        _m: &Modes,
+    ) {
+        self.events.push((t, kind));
+        self.event_contacts.push(contact);
+    }
+}
+
+/// The scenario's initial state (`rest` or `equilibrium`, plus its offsets).
+pub fn initial_of<M: System<N> + ?Sized, const N: usize>(
+    model: &M,
+    sc: &Scenario,
+) -> Result<[f64; N], StudyError> {
+    let mut offsets = [0.0; N];
+    offsets.copy_from_slice(&sc.offsets);
+    initial_state(model, sc.initial, &offsets).map_err(|e| {
+        StudyError::Input(InputError(format!(
+            "initial = {}: {e}",
+            sc.initial.as_str()
+        )))
+    })
+}
+
+fn run_model<M: System<N> + ?Sized, const N: usize>(
+    model: &M,
+    any: &AnyModel,
+    sc: &Scenario,
+    progress: &dyn Progress,
+    cancel: &Cancel,
+) -> Result<Run, StudyError> {
+    cancel.check()?;
+    let z0 = initial_of(model, sc)?;
+    let mut columns = vec!["t".to_string()];
+    columns.extend(model.names());
+    columns.extend(any.derived_columns());
+    let expected = (sc.duration * sc.sample_rate) as usize + 2;
+    let mut sink = Collect {
+        model,
+        any,
+        data: (0..columns.len())
+            .map(|_| Vec::with_capacity(expected))
+            .collect(),
+        derived: Vec::with_capacity(8),
+        obs: Vec::with_capacity(model.contacts()),
+        events: Vec::new(),
+        event_contacts: Vec::new(),
+        progress,
+        cancel,
+        until_check: CANCEL_EVERY,
+        t_end: sc.duration,
+        next_tick: 0.0,
+        ticks: 0,
+    };
+    let info = simulate(
+        model,
+        0.0,
+        z0,
+        sc.duration,
+        sc.sample_rate,
+        sc.solver,
+        &mut sink,
+    )
+    .map_err(|e| StudyError::Numerical(explain(e, sc.duration)))?;
+    progress.finish();
+    cancel.check()?;
+    Ok(Run {
+        columns,
+        data: sink.data,
+        events: sink.events,
+        event_contacts: sink.event_contacts,
+        contact_names: (0..model.contacts())
+            .map(|i| model.contact_name(i).to_string())
+            .collect(),
+        info,
+        integrate_s: 0.0,
+        sample_rate: sc.sample_rate,
+    })
+}
+
+/// An integration failure in words; an exhausted step budget says why the
+/// run could be that expensive.
+pub fn explain(e: squeal_core::IntegrateError, duration: f64) -> String {
+    match e {
+        squeal_core::IntegrateError::MaxSteps { t, steps } => format!(
+            "work budget exhausted at t = {t:.9e} s of {duration} s: {steps} steps (mean step {:.3e} s), \
+             far more than the fastest mode of steady sliding needs: the run became stiff (a steep \
+             friction law near v_rel = 0, chatter, or contact): check extreme parameter values, or loosen rtol/atol",
+            t / steps.max(1) as f64
+        ),
+        other => other.to_string(),
+    }
+}
+
+/// Integrate a scenario (checked by [`crate::feasible::prepare`] first),
+/// reporting thousandths of its duration to `progress`, stopping with
+/// [`StudyError::Interrupted`] soon after `cancel` is set.
+pub fn run(sc: &Scenario, progress: &dyn Progress, cancel: &Cancel) -> Result<Run, StudyError> {
+    crate::with_system!(&sc.model, m => run_model(m, &sc.model, sc, progress, cancel),
+        else => Err(StudyError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))))
+}
