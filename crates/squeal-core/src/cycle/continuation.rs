@@ -908,8 +908,8 @@ pub fn bifurcations<const N: usize>(seg: &[BranchPoint<N>]) -> Vec<Bifurcation> 
                 between,
                 value: Some(b.value),
                 detail: format!(
-                    "the branch turns back at {:.9e} (largest non-trivial |multiplier| {:.6})",
-                    b.value, b.cycle.max_multiplier
+                    "the parameter turns back (largest non-trivial |multiplier| {:.6}; 1 at the exact fold)",
+                    b.cycle.max_multiplier
                 ),
             });
         }
