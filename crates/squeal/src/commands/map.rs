@@ -9,9 +9,8 @@ use clap::Args;
 use serde_json::json;
 use squeal_plot::{Colormap, Format, HeatmapSpec};
 use squeal_study::map::{
-    agree, all_points, linear_grid, parse_axis, transient_grid, unit_of, CLASSES,
+    agree, all_points, check_distinct, linear_grid, parse_axis, transient_grid, unit_of, CLASSES,
 };
-use squeal_study::scenario::InputError;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -82,13 +81,7 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
     };
     let x = parse_axis(&a.x, "--x", a.log_x, &sc.model)?;
     let y = parse_axis(&a.y, "--y", a.log_y, &sc.model)?;
-    if x.name == y.name {
-        return Err(InputError(format!(
-            "--x and --y both vary {}: choose two parameters",
-            x.name
-        ))
-        .into());
-    }
+    check_distinct(&x, &y)?;
     let dest = a
         .out
         .clone()
