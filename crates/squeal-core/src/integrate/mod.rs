@@ -14,6 +14,7 @@
 //! that feeds uniformly sampled states and events into a [`Sink`].
 
 pub mod budget;
+pub mod ensemble;
 pub mod roots;
 mod tableau;
 
@@ -63,6 +64,9 @@ impl Default for SolverOptions {
         }
     }
 }
+
+/// PI stabilisation of the step-size controller (0 = the elementary controller).
+const STEP_BETA: f64 = 0.04;
 
 /// Most mode changes in a row at one instant before it counts as chatter.
 const SETTLE_LIMIT: usize = 16;
@@ -219,7 +223,11 @@ pub struct Solver<'m, M: System<N> + ?Sized, const N: usize> {
     modes: Modes,
     h: f64,
     last_rejected: bool,
-    err_old: f64,
+    /// `β`-th power of the last accepted error (at least 1e-4) for the PI
+    /// controller, computed at acceptance (off the critical path), so
+    /// that only one `powf` lies on the path from a step's error to the next
+    /// step size.
+    err_old_pow: f64,
     k: [[f64; N]; 16],
     /// Dense output of the last segment: y_old and F0..F6.
     y_old: [f64; N],
@@ -304,7 +312,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             modes,
             h: 0.0,
             last_rejected: false,
-            err_old: 1e-4,
+            err_old_pow: 1e-4f64.powf(STEP_BETA),
             k: [[0.0; N]; 16],
             y_old: z0,
             dense: [[0.0; N]; 7],
@@ -507,49 +515,53 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
         (100.0 * h0).min(h1).min(self.opts.h_max)
     }
 
-    /// `base + h·Σ_j row[j]·k[j]` over the first `upto` stages, skipping the
-    /// tableau's zeros; the state index is innermost so the loop vectorises.
+    /// Stage `S`: its state `z + h·Σ_j a[S][j]·k[j]` from the earlier
+    /// stages, and its slope, written straight into `k[S]` (the caller
+    /// counts the evaluations).
     #[inline(always)]
-    fn combine(&self, base: &[f64; N], row: &[f64], upto: usize, h: f64) -> [f64; N] {
-        let mut y = *base;
-        for j in 0..upto {
-            let a = h * row[j];
-            if a != 0.0 {
-                let kj = &self.k[j];
-                for i in 0..N {
-                    y[i] += a * kj[i];
-                }
-            }
-        }
-        y
-    }
-
-    /// Stage `s`: its state from the earlier stages, and its slope.
-    #[inline(always)]
-    fn stage(&mut self, s: usize, t: f64, z: &[f64; N], mode: Modes, h: f64) {
-        let y = self.combine(z, &A[s], s, h);
-        let mut ks = [0.0; N];
-        self.rhs(t + C[s] * h, mode, &y, &mut ks);
-        self.k[s] = ks;
+    fn stage<const S: usize>(&mut self, t: f64, z: &[f64; N], modes: &Modes, h: f64) {
+        let y = combine::<N, S>(&self.k, z, &A[S], h);
+        self.model.field(t + C[S] * h, modes, &y, &mut self.k[S]);
     }
 
     /// One RK step of size h from the current state; fills `k[0..13]`,
     /// returns the new state and the error norm.
     #[inline]
     fn rk_step(&mut self, h: f64) -> ([f64; N], f64) {
-        let (t, z, mode) = (self.t, self.z, self.modes);
+        let (t, z, modes) = (self.t, self.z, self.modes);
         self.k[0] = self.f;
-        for s in 1..12 {
-            self.stage(s, t, &z, mode, h);
-        }
-        let z_new = self.combine(&z, &B, 12, h);
-        let mut f_new = [0.0; N];
-        self.rhs(t + h, mode, &z_new, &mut f_new);
-        self.k[12] = f_new;
+        self.stage::<1>(t, &z, &modes, h);
+        self.stage::<2>(t, &z, &modes, h);
+        self.stage::<3>(t, &z, &modes, h);
+        self.stage::<4>(t, &z, &modes, h);
+        self.stage::<5>(t, &z, &modes, h);
+        self.stage::<6>(t, &z, &modes, h);
+        self.stage::<7>(t, &z, &modes, h);
+        self.stage::<8>(t, &z, &modes, h);
+        self.stage::<9>(t, &z, &modes, h);
+        self.stage::<10>(t, &z, &modes, h);
+        self.stage::<11>(t, &z, &modes, h);
+        let z_new = combine::<N, 12>(&self.k, &z, &B, h);
+        self.stats.rhs_evals += 12; // stages 1…11 and the slope at the end
+        self.model.field(t + h, &modes, &z_new, &mut self.k[12]);
         // Error estimate (Hairer's DOP853: 5th- and 3rd-order embedded errors).
         let zero = [0.0; N];
-        let e5 = self.combine(&zero, &E5, 13, 1.0);
-        let e3 = self.combine(&zero, &E3, 13, 1.0);
+        let e5 = combine::<N, 13>(&self.k, &zero, &E5, 1.0);
+        let e3 = combine::<N, 13>(&self.k, &zero, &E3, 1.0);
+        (z_new, self.error_norm(h, &z, &z_new, &e5, &e3))
+    }
+
+    /// The error norm of a step from `z` to `z_new` with the embedded
+    /// error estimates `e5`, `e3` (Hairer's DOP853 norm).
+    #[inline]
+    fn error_norm(
+        &self,
+        h: f64,
+        z: &[f64; N],
+        z_new: &[f64; N],
+        e5: &[f64; N],
+        e3: &[f64; N],
+    ) -> f64 {
         let mut err5 = 0.0;
         let mut err3 = 0.0;
         for i in 0..N {
@@ -557,25 +569,40 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             err5 += (e5[i] / sk).powi(2);
             err3 += (e3[i] / sk).powi(2);
         }
-        let err = if err5 == 0.0 && err3 == 0.0 {
+        if err5 == 0.0 && err3 == 0.0 {
             0.0
         } else {
             h.abs() * err5 / ((err5 + 0.01 * err3) * N as f64).sqrt()
-        };
-        (z_new, err)
+        }
     }
 
     /// Dense output coefficients of the accepted step (three more stages).
     #[inline]
     fn build_dense(&mut self, h: f64, z_new: &[f64; N]) {
-        let (t, z, mode) = (self.t, self.z, self.modes);
-        for s in 13..16 {
-            self.stage(s, t, &z, mode, h);
-        }
+        let (t, z, modes) = (self.t, self.z, self.modes);
+        self.stage::<13>(t, &z, &modes, h);
+        self.stage::<14>(t, &z, &modes, h);
+        self.stage::<15>(t, &z, &modes, h);
+        self.stats.rhs_evals += 3;
+        self.dense_coefficients(h, z_new);
+    }
+
+    /// The dense output's coefficients once all 16 slopes are known.
+    #[inline]
+    fn dense_coefficients(&mut self, h: f64, z_new: &[f64; N]) {
         let zero = [0.0; N];
-        for r in 0..4 {
-            self.dense[3 + r] = self.combine(&zero, &D[r], 16, h);
-        }
+        self.dense[3] = combine::<N, 16>(&self.k, &zero, &D[0], h);
+        self.dense[4] = combine::<N, 16>(&self.k, &zero, &D[1], h);
+        self.dense[5] = combine::<N, 16>(&self.k, &zero, &D[2], h);
+        self.dense[6] = combine::<N, 16>(&self.k, &zero, &D[3], h);
+        self.dense_low(h, z_new);
+    }
+
+    /// The dense output's low-order coefficients (from the step's ends) and
+    /// its origin, once `dense[3..7]` are in place.
+    #[inline]
+    fn dense_low(&mut self, h: f64, z_new: &[f64; N]) {
+        let z = self.z;
         for i in 0..N {
             let dy = z_new[i] - z[i];
             let f_old = self.k[0][i];
@@ -585,7 +612,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             self.dense[2][i] = 2.0 * dy - h * (f_new + f_old);
         }
         self.y_old = z;
-        self.t_old = t;
+        self.t_old = self.t;
         self.h_dense = h;
     }
 
@@ -619,9 +646,10 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
         out
     }
 
-    /// Power-basis coefficients in θ of the guard `c·y(θ) + d` on the step.
+    /// The guard `c·y(θ) + d` on the step in the dense output's own nested
+    /// form: its value `g0` at θ = 0 and the projections `g_r = c·F_r`.
     #[inline]
-    fn guard_poly(&self, c: &[f64; N], d: f64) -> [f64; 8] {
+    fn guard_dense(&self, c: &[f64; N], d: f64) -> (f64, [f64; 7]) {
         let mut g = [0.0; 7];
         let mut g0 = d;
         for i in 0..N {
@@ -630,30 +658,39 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 g[r] += c[i] * self.dense[r][i];
             }
         }
-        // y(θ) = y_old + θ(F0 + (1−θ)(F1 + θ(F2 + (1−θ)(F3 + θ(F4 + (1−θ)(F5 + θ F6)))))):
-        // from the inside out, add g_r then multiply by θ (r even) or 1 − θ (r odd).
-        let mut p = [0.0; 8];
-        for r in (0..7).rev() {
-            p[0] += g[r];
-            let mut q = [0.0; 8];
-            for i in 0..7 {
-                if r % 2 == 0 {
-                    q[i + 1] = p[i];
-                } else {
-                    q[i] += p[i];
-                    q[i + 1] -= p[i];
-                }
-            }
-            p = q;
-        }
-        p[0] += g0;
-        p
+        (g0, g)
+    }
+
+    /// Power-basis coefficients in θ of the guard `c·y(θ) + d` on the step.
+    #[inline]
+    fn guard_poly(&self, c: &[f64; N], d: f64) -> [f64; 8] {
+        let (g0, g) = self.guard_dense(c, d);
+        power_basis(g0, &g)
     }
 
     /// Advance by one accepted step, cut at the first event if one occurs in it.
     /// Returns the segment on which [`Self::dense_at`] is now valid, or `None`
     /// once the end time is reached.
     pub fn step(&mut self) -> Result<Option<Segment>, IntegrateError> {
+        let Some(t_stop) = self.begin_step()? else {
+            return Ok(None);
+        };
+        loop {
+            let (h, hits_stop) = self.attempt_size(t_stop)?;
+            let (z_new, err) = self.rk_step(h);
+            if !self.judge(h, hits_stop, &z_new, err)? {
+                continue;
+            }
+            self.build_dense(h, &z_new);
+            if let Some(seg) = self.settle(h, t_stop, z_new)? {
+                return Ok(Some(seg));
+            }
+        }
+    }
+
+    /// Start a step: `None` at the end time; else the time the step may not
+    /// pass (the end, or the model's next breakpoint).
+    fn begin_step(&mut self) -> Result<Option<f64>, IntegrateError> {
         if self.t >= self.t_end {
             return Ok(None);
         }
@@ -669,89 +706,132 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 t_stop = b;
             }
         }
+        Ok(Some(t_stop))
+    }
+
+    /// Size of the next attempt, and whether it is clipped to `t_stop`.
+    #[inline]
+    fn attempt_size(&self, t_stop: f64) -> Result<(f64, bool), IntegrateError> {
+        let mut h = self.h.min(self.opts.h_max);
+        let remaining = t_stop - self.t;
+        let mut hits_stop = false;
+        if h >= remaining * (1.0 - 1e-12) {
+            h = remaining;
+            hits_stop = true;
+        }
+        if h < self.h_min() && !hits_stop {
+            return Err(IntegrateError::StepUnderflow { t: self.t, h });
+        }
+        Ok((h, hits_stop))
+    }
+
+    /// Smallest step above round-off of the time.
+    #[inline]
+    fn h_min(&self) -> f64 {
+        16.0 * f64::EPSILON * self.t.abs().max(1e-6)
+    }
+
+    /// Accept or reject an attempt of size `h` with error norm `err`, and
+    /// choose the next size. `Ok(true)`: accepted (counted).
+    #[inline]
+    fn judge(
+        &mut self,
+        h: f64,
+        hits_stop: bool,
+        z_new: &[f64; N],
+        err: f64,
+    ) -> Result<bool, IntegrateError> {
         const SAFE: f64 = 0.9;
         const FAC_MIN: f64 = 1.0 / 3.0; // step may shrink to a third…
         const FAC_MAX: f64 = 6.0; // …or grow sixfold
-        const BETA: f64 = 0.04; // PI stabilisation (0 = the elementary controller)
-        let (z_new, h, first) = 'attempt: loop {
-            let (z_new, h) = loop {
-                let mut h = self.h.min(self.opts.h_max);
-                let remaining = t_stop - self.t;
-                let mut hits_stop = false;
-                if h >= remaining * (1.0 - 1e-12) {
-                    h = remaining;
-                    hits_stop = true;
-                }
-                let h_min = 16.0 * f64::EPSILON * self.t.abs().max(1e-6);
-                if h < h_min && !hits_stop {
-                    return Err(IntegrateError::StepUnderflow { t: self.t, h });
-                }
-                let (z_new, err) = self.rk_step(h);
-                if !err.is_finite() || z_new.iter().any(|x| !x.is_finite()) {
-                    if h < h_min {
-                        return Err(IntegrateError::NonFinite { t: self.t });
-                    }
-                    self.stats.rejected += 1;
-                    self.h = h * 0.1;
-                    self.last_rejected = true;
-                    continue;
-                }
-                // Proportional-integral step control (Gustafsson; Hairer–Nørsett–
-                // Wanner II.4 and the DOP853 code's BETA): the memory of the last
-                // accepted error damps the controller's oscillation on this
-                // oscillatory problem, which otherwise rejects one step in five.
-                let fac11 = err.powf(1.0 / 8.0 - 0.75 * BETA);
-                if err <= 1.0 {
-                    let fac = (fac11 / self.err_old.powf(BETA) / SAFE)
-                        .clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-                    self.err_old = err.max(1e-4);
-                    let mut h_new = h / fac;
-                    if self.last_rejected {
-                        h_new = h_new.min(h);
-                    }
-                    self.last_rejected = false;
-                    // After a step clipped to a stop, keep the unclipped proposal.
-                    self.h = if hits_stop { self.h.max(h_new) } else { h_new };
-                    break (z_new, h);
-                }
-                self.stats.rejected += 1;
-                self.last_rejected = true;
-                self.h = h / (fac11 / SAFE).min(1.0 / FAC_MIN);
-            };
+        const BETA: f64 = STEP_BETA;
+        if !err.is_finite() || z_new.iter().any(|x| !x.is_finite()) {
+            if h < self.h_min() {
+                return Err(IntegrateError::NonFinite { t: self.t });
+            }
+            self.stats.rejected += 1;
+            self.h = h * 0.1;
+            self.last_rejected = true;
+            return Ok(false);
+        }
+        // Proportional-integral step control (Gustafsson; Hairer–Nørsett–
+        // Wanner II.4 and the DOP853 code's BETA): the memory of the last
+        // accepted error damps the controller's oscillation on this
+        // oscillatory problem, which otherwise rejects one step in five.
+        let fac11 = err.powf(1.0 / 8.0 - 0.75 * BETA);
+        if err <= 1.0 {
+            let fac = (fac11 / self.err_old_pow / SAFE).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
+            self.err_old_pow = err.max(1e-4).powf(BETA);
+            let mut h_new = h / fac;
+            if self.last_rejected {
+                h_new = h_new.min(h);
+            }
+            self.last_rejected = false;
+            // After a step clipped to a stop, keep the unclipped proposal.
+            self.h = if hits_stop { self.h.max(h_new) } else { h_new };
             self.stats.accepted += 1;
-            self.build_dense(h, &z_new);
+            return Ok(true);
+        }
+        self.stats.rejected += 1;
+        self.last_rejected = true;
+        self.h = h / (fac11 / SAFE).min(1.0 / FAC_MIN);
+        Ok(false)
+    }
 
-            // Earliest upward crossing of any guard on the step.
-            let tol = (self.opts.event_tol / h).clamp(4.0 * f64::EPSILON, 1e-9);
-            let mut first: Option<(f64, usize)> = None;
-            let mut bounds = None;
-            for gi in 0..self.guards.len() {
-                let g = self.guards.as_slice()[gi];
-                let found = if g.affine {
-                    let p = self.guard_poly(&g.c, g.d);
-                    roots::first_upcrossing(&p, tol)
+    /// Finish an accepted step whose dense output is built: locate the
+    /// earliest guard crossing, and cut the step there or take it whole.
+    /// `Ok(None)`: the step must be retried shorter (the search gave up).
+    fn settle(
+        &mut self,
+        h: f64,
+        t_stop: f64,
+        z_new: [f64; N],
+    ) -> Result<Option<Segment>, IntegrateError> {
+        // Earliest upward crossing of any guard on the step.
+        let tol = (self.opts.event_tol / h).clamp(4.0 * f64::EPSILON, 1e-9);
+        let mut first: Option<(f64, usize)> = None;
+        let mut bounds = None;
+        for gi in 0..self.guards.len() {
+            let g = self.guards.as_slice()[gi];
+            let found = if g.affine {
+                let (g0, gr) = self.guard_dense(&g.c, g.d);
+                if clearly_negative(g0, &gr) {
+                    None
                 } else {
-                    let b = *bounds.get_or_insert_with(|| self.step_bounds());
-                    match self.lipschitz_upcrossing(&g, h, &b, tol) {
-                        Ok(found) => found,
-                        Err(()) => {
-                            // The bound is too loose on a step this long: retry at a quarter.
-                            self.stats.accepted -= 1;
-                            self.stats.rejected += 1;
-                            self.last_rejected = true;
-                            self.h = 0.25 * h;
-                            continue 'attempt;
-                        }
+                    roots::first_upcrossing(&power_basis(g0, &gr), tol)
+                }
+            } else {
+                let b = *bounds.get_or_insert_with(|| self.step_bounds());
+                match self.lipschitz_upcrossing(&g, h, &b, tol) {
+                    Ok(found) => found,
+                    Err(()) => {
+                        // The bound is too loose on a step this long: retry at a quarter.
+                        self.stats.accepted -= 1;
+                        self.stats.rejected += 1;
+                        self.last_rejected = true;
+                        self.h = 0.25 * h;
+                        return Ok(None);
                     }
-                };
-                if let Some(theta) = found {
-                    if first.is_none_or(|(best, _)| theta < best) {
-                        first = Some((theta, gi));
-                    }
+                }
+            };
+            if let Some(theta) = found {
+                if first.is_none_or(|(best, _)| theta < best) {
+                    first = Some((theta, gi));
                 }
             }
-            break (z_new, h, first);
-        };
+        }
+        self.finish(h, t_stop, z_new, first).map(Some)
+    }
+
+    /// Take the accepted step to its end, or to the first event `first`
+    /// (fraction of the step, guard index) and through the transition.
+    fn finish(
+        &mut self,
+        h: f64,
+        t_stop: f64,
+        z_new: [f64; N],
+        first: Option<(f64, usize)>,
+    ) -> Result<Segment, IntegrateError> {
         let modes = self.modes;
         let mode = modes.first();
         let t0 = self.t;
@@ -766,7 +846,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 self.t = t1;
                 self.z = z_new;
                 self.f = self.k[12];
-                Ok(Some(Segment {
+                Ok(Segment {
                     t0,
                     t1,
                     mode,
@@ -774,7 +854,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                     event: None,
                     contact: 0,
                     switched: false,
-                }))
+                })
             }
             Some((theta, gi)) => {
                 let t1 = t0 + theta * h;
@@ -793,7 +873,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 self.enter_mode(next)?;
                 // A step cut short by an event: restart no larger than the part used.
                 self.h = self.h.min(h);
-                Ok(Some(Segment {
+                Ok(Segment {
                     t0,
                     t1,
                     mode,
@@ -801,7 +881,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                     event: ev,
                     contact: g.contact as usize,
                     switched: next != modes || ev.is_some(),
-                }))
+                })
             }
         }
     }
@@ -902,6 +982,74 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
     }
 }
 
+/// Power-basis coefficients of the dense output's nested form
+/// `g0 + θ(g_0 + (1−θ)(g_1 + θ(g_2 + (1−θ)(g_3 + θ(g_4 + (1−θ)(g_5 + θ g_6))))))`.
+#[inline]
+fn power_basis(g0: f64, g: &[f64; 7]) -> [f64; 8] {
+    // From the inside out, add g_r then multiply by θ (r even) or 1 − θ (r odd).
+    let mut p = [0.0; 8];
+    for r in (0..7).rev() {
+        p[0] += g[r];
+        let mut q = [0.0; 8];
+        for i in 0..7 {
+            if r % 2 == 0 {
+                q[i + 1] = p[i];
+            } else {
+                q[i] += p[i];
+                q[i + 1] -= p[i];
+            }
+        }
+        p = q;
+    }
+    p[0] += g0;
+    p
+}
+
+/// Whether a guard in the nested form of [`power_basis`] is negative on the
+/// whole step with a margin far above round-off, so that the root search
+/// would find no crossing: θ and 1 − θ lie in [0, 1], so every Bernstein
+/// coefficient of `g − g0` on [0, 1] is at most `Σ|g_r|` in magnitude (the
+/// Bernstein coefficients of a product are convex combinations of products
+/// of the factors' coefficients). The 1e-9 relative margin covers the
+/// round-off of the power and Bernstein conversions (≈ 1e-12 relative), so
+/// [`roots::first_upcrossing`] would see only negative coefficients and
+/// return `None`: the answer is the same, without either conversion.
+#[inline]
+fn clearly_negative(g0: f64, g: &[f64; 7]) -> bool {
+    let s: f64 = g.iter().map(|x| x.abs()).sum();
+    g0 < 0.0 && s + 1e-9 * (s - g0) < -g0
+}
+
+/// `base + Σ_{j<J} (h·row[j])·k[j]`, the stage combination of a tableau row.
+/// `row` is a constant of [`tableau`] and `J` a constant, so once inlined the
+/// terms are written out one by one (no loop) and the tableau's zeros vanish
+/// at compile time (the test is on the constant; `h·row[j]` is never zero
+/// for a non-zero entry). The state index is innermost, so each term is a
+/// few vector instructions. The terms are added in the order of `j`: the
+/// same sums, bit for bit, as a loop.
+#[inline(always)]
+fn combine<const N: usize, const J: usize>(
+    k: &[[f64; N]; 16],
+    base: &[f64; N],
+    row: &[f64],
+    h: f64,
+) -> [f64; N] {
+    let mut y = *base;
+    macro_rules! terms {
+        ($($j:literal)*) => {$(
+            if $j < J && row[$j] != 0.0 {
+                let a = h * row[$j];
+                let kj = &k[$j];
+                for i in 0..N {
+                    y[i] += a * kj[i];
+                }
+            }
+        )*};
+    }
+    terms!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
+    y
+}
+
 /// Ranges of the states and of their θ-derivatives over one step.
 #[derive(Debug, Clone, Copy)]
 struct StepBounds<const N: usize> {
@@ -932,30 +1080,88 @@ pub fn simulate<M: System<N> + ?Sized, S: Sink<N>, const N: usize>(
     opts: SolverOptions,
     sink: &mut S,
 ) -> Result<RunInfo, IntegrateError> {
+    check_rate(sample_rate)?;
+    let mut solver = Solver::new(model, t0, z0, t_end, opts)?;
+    let mut feed = Feed::new(t0, t_end, sample_rate);
+    if let Some(info) = feed.start(&mut solver, sink) {
+        return Ok(info);
+    }
+    while let Some(seg) = solver.step()? {
+        if let Some(info) = feed.segment(&mut solver, &seg, sink) {
+            return Ok(info);
+        }
+    }
+    Ok(RunInfo {
+        stats: *solver.stats(),
+        t_final: solver.t(),
+        stopped_early: false,
+    })
+}
+
+/// A sample rate must be positive and finite.
+fn check_rate(sample_rate: f64) -> Result<(), IntegrateError> {
     if !(sample_rate > 0.0 && sample_rate.is_finite()) {
         return Err(IntegrateError::BadOptions(format!(
             "sample_rate = {sample_rate} (must be > 0)"
         )));
     }
-    let mut solver = Solver::new(model, t0, z0, t_end, opts)?;
-    while let Some((ev, c, z, m)) = solver.take_pending_contact_event() {
-        sink.contact_event(t0, ev, c, &z, &m);
+    Ok(())
+}
+
+/// What [`simulate`] feeds a sink: uniform samples and events, segment by
+/// segment (shared with the ensemble, so both feed sinks identically).
+struct Feed {
+    t0: f64,
+    t_end: f64,
+    sample_rate: f64,
+    /// Index of the next sample.
+    k: u64,
+}
+
+impl Feed {
+    fn new(t0: f64, t_end: f64, sample_rate: f64) -> Self {
+        Feed {
+            t0,
+            t_end,
+            sample_rate,
+            k: 0,
+        }
     }
-    let dt = 1.0 / sample_rate;
-    let mut k: u64 = 0;
-    if sink.sample_modes(t0, solver.state(), &solver.modes()) == Flow::Stop {
-        return Ok(RunInfo {
-            stats: *solver.stats(),
-            t_final: t0,
-            stopped_early: true,
-        });
+
+    /// The events of the start and the first sample; `Some` if the sink stops.
+    fn start<M: System<N> + ?Sized, S: Sink<N>, const N: usize>(
+        &mut self,
+        solver: &mut Solver<'_, M, N>,
+        sink: &mut S,
+    ) -> Option<RunInfo> {
+        let t0 = self.t0;
+        while let Some((ev, c, z, m)) = solver.take_pending_contact_event() {
+            sink.contact_event(t0, ev, c, &z, &m);
+        }
+        self.k = 1;
+        if sink.sample_modes(t0, solver.state(), &solver.modes()) == Flow::Stop {
+            return Some(RunInfo {
+                stats: *solver.stats(),
+                t_final: t0,
+                stopped_early: true,
+            });
+        }
+        None
     }
-    k += 1;
-    while let Some(seg) = solver.step()? {
+
+    /// The samples on a segment and the events at its end; `Some` if the sink stops.
+    fn segment<M: System<N> + ?Sized, S: Sink<N>, const N: usize>(
+        &mut self,
+        solver: &mut Solver<'_, M, N>,
+        seg: &Segment,
+        sink: &mut S,
+    ) -> Option<RunInfo> {
+        let (t0, t_end, sample_rate) = (self.t0, self.t_end, self.sample_rate);
+        let dt = 1.0 / sample_rate;
         loop {
             // k/rate, not k·dt: exact for every representable sample time, so the
             // sample at t_end is not lost to round-off (0.03 s at 10 kHz is k = 300).
-            let ts = t0 + k as f64 / sample_rate;
+            let ts = t0 + self.k as f64 / sample_rate;
             // The last segment also takes a sample a hair past t_end (round-off).
             let limit = if seg.t1 >= t_end {
                 t_end + 1e-9 * dt
@@ -967,9 +1173,9 @@ pub fn simulate<M: System<N> + ?Sized, S: Sink<N>, const N: usize>(
             }
             let ts = ts.min(seg.t1);
             let z = solver.dense_at(ts);
-            k += 1;
+            self.k += 1;
             if sink.sample_modes(ts, &z, &seg.modes) == Flow::Stop {
-                return Ok(RunInfo {
+                return Some(RunInfo {
                     stats: *solver.stats(),
                     t_final: ts,
                     stopped_early: true,
@@ -982,10 +1188,109 @@ pub fn simulate<M: System<N> + ?Sized, S: Sink<N>, const N: usize>(
         while let Some((ev, c, z, m)) = solver.take_pending_contact_event() {
             sink.contact_event(seg.t1, ev, c, &z, &m);
         }
+        None
     }
-    Ok(RunInfo {
-        stats: *solver.stats(),
-        t_final: solver.t(),
-        stopped_early: false,
-    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (no dependency): xorshift64*.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            let u = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
+            u as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        }
+    }
+
+    /// The unrolled combinations add the same terms in the same order as the
+    /// plain loop over the tableau row that skips zeros at run time.
+    #[test]
+    fn unrolled_combinations_equal_the_runtime_loop_bit_for_bit() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        for _ in 0..200 {
+            let mut k = [[0.0; 8]; 16];
+            for row in k.iter_mut() {
+                for x in row.iter_mut() {
+                    *x = rng.next() * 10f64.powi((rng.next() * 8.0) as i32);
+                }
+            }
+            let base: [f64; 8] = std::array::from_fn(|_| rng.next());
+            let h = 1e-6 * (1.5 + rng.next());
+            let plain = |row: &[f64], upto: usize, h: f64| {
+                let mut y = base;
+                for j in 0..upto {
+                    let a = h * row[j];
+                    if a != 0.0 {
+                        for i in 0..8 {
+                            y[i] += a * k[j][i];
+                        }
+                    }
+                }
+                y
+            };
+            let bits = |y: [f64; 8]| y.map(f64::to_bits);
+            assert_eq!(
+                bits(combine::<8, 5>(&k, &base, &A[5], h)),
+                bits(plain(&A[5], 5, h))
+            );
+            assert_eq!(
+                bits(combine::<8, 11>(&k, &base, &A[11], h)),
+                bits(plain(&A[11], 11, h))
+            );
+            assert_eq!(
+                bits(combine::<8, 15>(&k, &base, &A[15], h)),
+                bits(plain(&A[15], 15, h))
+            );
+            assert_eq!(
+                bits(combine::<8, 12>(&k, &base, &B, h)),
+                bits(plain(&B, 12, h))
+            );
+            assert_eq!(
+                bits(combine::<8, 13>(&k, &base, &E5, 1.0)),
+                bits(plain(&E5, 13, 1.0))
+            );
+            assert_eq!(
+                bits(combine::<8, 16>(&k, &base, &D[2], h)),
+                bits(plain(&D[2], 16, h))
+            );
+        }
+    }
+
+    /// Whenever the cheap bound dismisses a guard, the guard is negative on
+    /// the whole step (dense sampling) and the root search finds nothing;
+    /// and the bound does dismiss the easy cases.
+    #[test]
+    fn dismissed_guards_have_no_crossing() {
+        let mut rng = Rng(0x1234_5678_9abc_def1);
+        let mut dismissed = 0;
+        for n in 0..20_000 {
+            let g0 = -rng.next().abs() - 1e-3;
+            // Coefficients from tiny to a little more than |g0|.
+            let scale = g0.abs() * 10f64.powf(-4.0 * rng.next().abs()) * 0.3;
+            let g: [f64; 7] = std::array::from_fn(|_| scale * rng.next());
+            if !clearly_negative(g0, &g) {
+                continue;
+            }
+            dismissed += 1;
+            let p = power_basis(g0, &g);
+            assert_eq!(roots::first_upcrossing(&p, 1e-12), None, "case {n}");
+            for s in 0..=200 {
+                let x = s as f64 / 200.0;
+                assert!(roots::horner(&p, x) < 0.0, "case {n} at θ = {x}");
+            }
+        }
+        assert!(dismissed > 5_000, "{dismissed} dismissed");
+        // Not dismissed: a guard that reaches zero within the bound.
+        assert!(!clearly_negative(
+            -1.0,
+            &[0.5, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0]
+        ));
+        assert!(!clearly_negative(0.0, &[0.0; 7]));
+    }
 }

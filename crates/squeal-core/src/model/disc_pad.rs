@@ -331,7 +331,7 @@ impl Model<8> for DiscPad {
     }
 
     /// MODEL.md §3 (slip), §4 (stick), and free flight without contact.
-    #[inline]
+    #[inline(always)]
     fn rhs(&self, t: f64, mode: Mode, z: &[f64; 8], dz: &mut [f64; 8]) {
         let p = &self.p;
         let (f_y, f_t, a_stick) = match mode {
@@ -343,13 +343,16 @@ impl Model<8> for DiscPad {
             Mode::SlipPos | Mode::SlipNeg => {
                 let f_y = self.layer_force(z);
                 // s·v, not |v|: equal in the mode's domain, and smooth past its
-                // guard, so a step that overshoots the event sees no kink.
-                let v = mode.slip_sign() * self.sliding_velocity(z);
-                (
-                    f_y,
-                    mode.slip_sign() * self.friction.mu(v) * self.friction_normal(f_y),
-                    None,
-                )
+                // guard, so a step that overshoots the event sees no kink. The
+                // sign s = ±1 is applied as a negation, not a product: the same
+                // bits, three cycles less on the stages' critical path.
+                let v = self.sliding_velocity(z);
+                let s_mu = if mode == Mode::SlipPos {
+                    self.friction.mu(v)
+                } else {
+                    -self.friction.mu(-v)
+                };
+                (f_y, s_mu * self.friction_normal(f_y), None)
             }
         };
         let f_f = p.alpha * f_t * z[YD];

@@ -86,7 +86,9 @@ pub trait System<const N: usize>: Sync {
     fn contacts(&self) -> usize;
     /// Name of contact `i` (`events.csv`'s `contact` column).
     fn contact_name(&self, i: usize) -> &str;
-    /// Right-hand side `dz = f(t, z)` in `modes` (in stick: the constrained dynamics).
+    /// Right-hand side `dz = f(t, z)` in `modes` (in stick: the constrained
+    /// dynamics). Every component of `dz` must be written: it holds the last
+    /// stage's slope on entry (the integrator writes slopes in place).
     fn field(&self, t: f64, modes: &Modes, z: &[f64; N], dz: &mut [f64; N]);
     /// The guards that end `modes`.
     fn mode_guards(&self, modes: &Modes, out: &mut Guards<N>);

@@ -1,0 +1,215 @@
+//! The L-lane ensemble (issue 16, point 2) against one-at-a-time runs: the
+//! same events, the same outcome and the same samples, bit for bit, also for
+//! lanes that stop early or fail while the others go on.
+
+use squeal_core::integrate::ensemble::{simulate_ensemble, Job};
+use squeal_core::model::Mode;
+use squeal_core::sink::Recorder;
+use squeal_core::{
+    simulate, Belt, DiscPad, EventKind, Flow, FrictionLaw, IntegrateError, RunInfo, Sink,
+    SolverOptions, System,
+};
+
+/// A recorder that stops the run after `limit` samples.
+#[derive(Debug, Clone, Default)]
+struct Upto<const N: usize> {
+    rec: Recorder<N>,
+    limit: usize,
+}
+
+impl<const N: usize> Sink<N> for Upto<N> {
+    fn sample(&mut self, t: f64, z: &[f64; N], mode: Mode) -> Flow {
+        self.rec.sample(t, z, mode);
+        if self.rec.t.len() >= self.limit {
+            Flow::Stop
+        } else {
+            Flow::Continue
+        }
+    }
+    fn event(&mut self, t: f64, kind: EventKind, z: &[f64; N], mode: Mode) {
+        self.rec.event(t, kind, z, mode)
+    }
+}
+
+/// A job's description: start, end, options and sample limit.
+struct Case<const N: usize> {
+    z0: [f64; N],
+    t_end: f64,
+    opts: SolverOptions,
+    limit: usize,
+}
+
+/// Run `cases` on `models` one at a time and as an ensemble of `L` lanes;
+/// assert identical results. Returns the one-at-a-time results.
+fn same_as_single<M: System<N>, const N: usize>(
+    models: &[M],
+    cases: &[Case<N>],
+    rate: f64,
+) -> Vec<Result<(RunInfo, Upto<N>), IntegrateError>> {
+    let single: Vec<_> = models
+        .iter()
+        .zip(cases)
+        .map(|(m, c)| {
+            let mut sink = Upto {
+                rec: Recorder::new(),
+                limit: c.limit,
+            };
+            simulate(m, 0.0, c.z0, c.t_end, rate, c.opts, &mut sink).map(|info| (info, sink))
+        })
+        .collect();
+    let mut jobs: Vec<Job<'_, M, Upto<N>, N>> = models
+        .iter()
+        .zip(cases)
+        .map(|(m, c)| Job {
+            model: m,
+            t0: 0.0,
+            z0: c.z0,
+            t_end: c.t_end,
+            opts: c.opts,
+            sink: Upto {
+                rec: Recorder::new(),
+                limit: c.limit,
+            },
+        })
+        .collect();
+    let together = simulate_ensemble::<M, Upto<N>, N>(&mut jobs, rate);
+    assert_eq!(together.len(), single.len());
+    for (k, ((one, many), job)) in single.iter().zip(&together).zip(&jobs).enumerate() {
+        match (one, many) {
+            (Ok((info, sink)), Ok(info_e)) => {
+                assert_eq!(info, info_e, "job {k}: run summaries differ");
+                let (a, b) = (&sink.rec, &job.sink.rec);
+                assert_eq!(a.t.len(), b.t.len(), "job {k}: sample counts");
+                for (s, (za, zb)) in a.z.iter().zip(&b.z).enumerate() {
+                    for i in 0..N {
+                        assert_eq!(
+                            za[i].to_bits(),
+                            zb[i].to_bits(),
+                            "job {k} sample {s} state {i}"
+                        );
+                    }
+                }
+                for (ta, tb) in a.t.iter().zip(&b.t) {
+                    assert_eq!(ta.to_bits(), tb.to_bits(), "job {k}: sample times");
+                }
+                assert_eq!(a.mode, b.mode, "job {k}: modes");
+                assert_eq!(a.events.len(), b.events.len(), "job {k}: event counts");
+                for (ea, eb) in a.events.iter().zip(&b.events) {
+                    assert_eq!(ea.t.to_bits(), eb.t.to_bits(), "job {k}: event times");
+                    assert_eq!((ea.kind, ea.mode), (eb.kind, eb.mode), "job {k}");
+                    assert_eq!(ea.z.map(f64::to_bits), eb.z.map(f64::to_bits), "job {k}");
+                }
+            }
+            (Err(a), Err(b)) => assert_eq!(a, b, "job {k}: errors differ"),
+            _ => panic!("job {k}: one run failed and the other did not: {one:?} vs {many:?}"),
+        }
+    }
+    single
+}
+
+/// Disc–pad runs of every kind: growth from rest, stick-slip with reversals
+/// and sticks from a kicked start, a Stribeck law, a ramped follower force,
+/// a run stopped by its sink, a run out of steps, a run refused at start.
+#[test]
+fn disc_pad_lanes_match_single_runs() {
+    let base = DiscPad::default();
+    let mut models = Vec::new();
+    let mut cases = Vec::new();
+    let opts = SolverOptions::default();
+    let eq = squeal_core::Model::equilibrium(&base).unwrap();
+    let kicked = |vx_p: f64| {
+        let mut z = eq;
+        z[5] = vx_p;
+        z
+    };
+    let mut push = |m: DiscPad, z0: [f64; 8], t_end: f64, opts: SolverOptions, limit: usize| {
+        models.push(m);
+        cases.push(Case {
+            z0,
+            t_end,
+            opts,
+            limit,
+        });
+    };
+    push(base, [0.0; 8], 0.01, opts, usize::MAX);
+    push(base, kicked(1.5), 0.01, opts, usize::MAX);
+    let mut strib = base;
+    strib.friction = FrictionLaw::by_name("stribeck").unwrap();
+    push(strib, kicked(2.0), 0.008, opts, usize::MAX);
+    let mut fast = base;
+    fast.p.V = 3.0;
+    fast.p.N = 2000.0;
+    push(fast, kicked(-1.0), 0.012, opts, usize::MAX);
+    // Stopped by its sink after 37 samples while the others go on.
+    push(base, kicked(1.2), 0.01, opts, 37);
+    // Out of steps: fails while the others go on.
+    let short = SolverOptions {
+        max_steps: 300,
+        ..opts
+    };
+    push(base, kicked(1.5), 0.01, short, usize::MAX);
+    // Refused at the start (end before start).
+    let mut ramp = base;
+    ramp.p.alpha = 2.0;
+    ramp.p.t_ramp = 0.002;
+    push(ramp, [0.0; 8], -1.0, opts, usize::MAX);
+    push(ramp, [0.0; 8], 0.006, opts, usize::MAX);
+    let mut soft = base;
+    soft.p.k_py = 4.0e8;
+    push(soft, kicked(1.8), 0.015, opts, usize::MAX);
+
+    let single = same_as_single::<DiscPad, 8>(&models, &cases, 50_000.0);
+    // The cases are what they claim to be.
+    let ok: Vec<_> = single.iter().filter_map(|r| r.as_ref().ok()).collect();
+    assert!(
+        ok.iter().any(|(i, _)| i.stopped_early),
+        "a lane stops early"
+    );
+    assert!(matches!(single[5], Err(IntegrateError::MaxSteps { .. })));
+    assert!(matches!(single[6], Err(IntegrateError::BadOptions(_))));
+    let reversals: u64 = ok
+        .iter()
+        .map(|(i, _)| i.stats.event_count(EventKind::Reverse))
+        .sum();
+    let sticks: u64 = ok
+        .iter()
+        .map(|(i, _)| i.stats.event_count(EventKind::Stick))
+        .sum();
+    assert!(
+        reversals > 10 && sticks > 0,
+        "{reversals} reversals, {sticks} sticks"
+    );
+    // Fewer jobs than lanes.
+    same_as_single::<DiscPad, 8>(&models[..2], &cases[..2], 50_000.0);
+}
+
+/// The mass on a belt with Coulomb stick-slip (exact sticks and slips),
+/// more jobs than lanes so that lanes are refilled.
+#[test]
+fn belt_lanes_match_single_runs() {
+    let mut models = Vec::new();
+    let mut cases = Vec::new();
+    for k in 0..11 {
+        let mut b = Belt {
+            friction: FrictionLaw::Coulomb {
+                mu_s: 0.4,
+                mu_k: 0.3,
+            },
+            ..Belt::default()
+        };
+        b.p.V = 0.1 + 0.02 * k as f64;
+        models.push(b);
+        cases.push(Case {
+            z0: [0.0; 2],
+            t_end: 1.0 + 0.5 * k as f64,
+            opts: SolverOptions::default(),
+            limit: if k == 3 { 150 } else { usize::MAX },
+        });
+    }
+    let single = same_as_single::<Belt, 2>(&models, &cases, 1000.0);
+    let sticking = single
+        .iter()
+        .filter(|r| r.as_ref().unwrap().0.stats.event_count(EventKind::Stick) > 0)
+        .count();
+    assert!(sticking >= 8, "{sticking} of 11 runs stick");
+}
