@@ -44,7 +44,7 @@ fig.colorbar(pc, ax=ax[0], label="max growth rate σ (1/s)")
 ax[0].set(xlabel="V (m/s)", ylabel="N (N)", title="stability of steady sliding (σ > 0: squeal)")
 
 ax[1].semilogy(f, psd, lw=0.9)
-ax[1].set(xlim=(0, 5000), xlabel="frequency (Hz)", ylabel="PSD of vx_p ((m/s)²/Hz)",
+ax[1].set(xlim=(0, 30000), xlabel="frequency (Hz)", ylabel="PSD of vx_p ((m/s)²/Hz)",
           title=f"default run: pad spectrum, verdict {run.summary['verdict']}")
 
 ax[2].plot(tr.t, tr["vx_p"], lw=0.6)
