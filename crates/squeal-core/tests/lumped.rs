@@ -820,3 +820,164 @@ fn large_decoupled_model_has_the_closed_form_eigenvalues() {
         }
     }
 }
+
+/// The simulation's right-hand side of a small model runs on folded
+/// operators (springs, `K`, `C` in one sparse list, constant forces in one
+/// vector, contacts as index pairs); the stability and equilibrium code on
+/// the element loops. Both are the same force: equal to 1e-12 of the
+/// largest term, in every mode combination, with a follower force, a
+/// ramped force, a bilateral contact, a prescribed load, a mass matrix
+/// with off-diagonal terms, and after parameters changed by `set`.
+#[test]
+fn folded_field_equals_the_element_loops() {
+    use squeal_core::model::lumped::{disc_pad_spec, two_pad_spec, Fixed, Triplets};
+    let mut follower = disc_pad_spec(&DiscPad::default());
+    follower.contacts[0].alpha = 0.4;
+    follower.forces[0].ramp = 0.01;
+    let mut bilateral = two_pad_spec();
+    bilateral.contacts[1].bilateral = true;
+    let mut belt = LumpedSpec {
+        dofs: vec!["x".into(), "y".into()],
+        masses: terms(&[("x", 1.0), ("y", 2.0)]),
+        m: Some(Triplets {
+            rows: 2,
+            cols: 2,
+            entries: vec![(0, 1, 0.3), (1, 0, 0.3)],
+        }),
+        k: Some(Triplets {
+            rows: 2,
+            cols: 2,
+            entries: vec![(0, 0, 1e4), (0, 1, -2e3), (1, 0, -2e3), (1, 1, 3e4)],
+        }),
+        springs: vec![spring("sx", &[("x", 1.0), ("y", -0.5)], 5e3, 0.7)],
+        forces: vec![force("f", &[("y", 1.0)], 20.0)],
+        ..Default::default()
+    };
+    belt.contacts.push(prescribed(
+        "belt",
+        &[("x", -1.0)],
+        100.0,
+        0.5,
+        FrictionLaw::Stribeck {
+            mu_s: 0.5,
+            mu_k: 0.3,
+            v_s: 0.1,
+            delta: 2.0,
+            sigma: 0.01,
+        },
+    ));
+    let mut seed = 7u64;
+    let mut rnd = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let check = |l: &Lumped, label: &str, z: &[f64]| {
+        let nc = l.contacts.len();
+        let all = [Mode::SlipPos, Mode::SlipNeg, Mode::Stick, Mode::Free];
+        for code in 0..4usize.pow(nc as u32) {
+            let mut modes = Modes::all(nc, Mode::SlipPos);
+            for i in 0..nc {
+                modes.set(i, all[(code / 4usize.pow(i as u32)) % 4]);
+            }
+            for t in [0.003, 1.0] {
+                let want = l.field_dyn(t, &modes, z);
+                let got: Vec<f64> = match z.len() {
+                    4 => {
+                        let mut dz = [0.0; 4];
+                        Fixed::<4>(l).field(t, &modes, z.try_into().unwrap(), &mut dz);
+                        dz.to_vec()
+                    }
+                    8 => {
+                        let mut dz = [0.0; 8];
+                        Fixed::<8>(l).field(t, &modes, z.try_into().unwrap(), &mut dz);
+                        dz.to_vec()
+                    }
+                    12 => {
+                        let mut dz = [0.0; 12];
+                        Fixed::<12>(l).field(t, &modes, z.try_into().unwrap(), &mut dz);
+                        dz.to_vec()
+                    }
+                    _ => unreachable!(),
+                };
+                let scale = want.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                for (a, b) in got.iter().zip(&want) {
+                    assert!(
+                        (a - b).abs() <= 1e-12 * scale,
+                        "{label} {modes:?} t={t}: {got:?} vs {want:?}"
+                    );
+                }
+            }
+        }
+    };
+    for (label, spec, pos, vel) in [
+        ("follower", follower, 1e-6, 0.5),
+        ("two-pad bilateral", bilateral, 1e-6, 0.5),
+        ("belt with M, K", belt, 1e-2, 0.5),
+    ] {
+        let mut l = lumped(&spec);
+        let n = l.dof_count();
+        for round in 0..3 {
+            let z: Vec<f64> = (0..2 * n)
+                .map(|i| if i < n { pos * rnd() } else { vel * rnd() })
+                .collect();
+            check(&l, label, &z);
+            // Change every parameter a little through `set`, then again.
+            for (k, v) in l.keys() {
+                if v != 0.0 && !k.starts_with("mass.") && !k.ends_with(".ramp") {
+                    l.set(&k, v * (1.0 + 0.01 * (round + 1) as f64)).unwrap();
+                }
+            }
+        }
+    }
+}
+
+/// Above 64 dofs Newton's steady-sliding solve runs on faer's LU: a dof
+/// held by nothing (a zero row and column) is refused as singular, as the
+/// small models' nalgebra path does; held, the equilibrium balances every
+/// force (residual at round-off).
+#[test]
+fn large_equilibrium_is_solved_and_a_free_dof_is_refused() {
+    let n = 70;
+    let mut spec = LumpedSpec {
+        dofs: (0..n).map(|i| format!("q{i}")).collect(),
+        masses: (0..n).map(|i| (format!("q{i}"), 1.0)).collect(),
+        ..Default::default()
+    };
+    for i in 1..n {
+        spec.springs.push(spring(
+            &format!("s{i}"),
+            &[(&format!("q{i}"), 1.0), (&format!("q{}", i - 1), -1.0)],
+            1e5 * (1.0 + i as f64 / n as f64),
+            0.1,
+        ));
+    }
+    spec.forces.push(force("f", &[("q5", 1.0)], 3.0));
+    spec.contacts.push(prescribed(
+        "belt",
+        &[("q1", -1.0)],
+        100.0,
+        1.0,
+        FrictionLaw::Coulomb {
+            mu_s: 0.5,
+            mu_k: 0.3,
+        },
+    ));
+    spec.springs
+        .push(spring("ground", &[("q0", 1.0)], 2e5, 0.1));
+    let l = lumped(&spec);
+    let z = l.equilibrium_dyn().unwrap();
+    let f = l.field_dyn(f64::INFINITY, &l.steady_modes(), &z);
+    let scale = 100.0;
+    assert!(
+        f[n..].iter().all(|a| a.abs() <= 1e-9 * scale),
+        "{:?}",
+        &f[n..]
+    );
+    spec.dofs.push("loose".into());
+    spec.masses.push(("loose".into(), 1.0));
+    let l = lumped(&spec);
+    let e = l.equilibrium_dyn().unwrap_err().to_string();
+    assert!(e.contains("singular"), "{e}");
+}

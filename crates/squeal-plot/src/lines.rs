@@ -25,12 +25,40 @@ pub struct Series<'a> {
     pub x: &'a [f64],
     /// Ordinates.
     pub y: &'a [f64],
+    /// Drawn dashed (e.g. the unstable part of a bifurcation diagram).
+    pub dashed: bool,
+    /// Colour: index into the palette; `None` is the series' own position.
+    pub colour: Option<usize>,
+    /// A non-finite point breaks the line (instead of being skipped).
+    pub gaps: bool,
 }
 
 impl<'a> Series<'a> {
     /// A labelled series.
     pub fn new(label: &'a str, x: &'a [f64], y: &'a [f64]) -> Self {
-        Series { label, x, y }
+        Series {
+            label,
+            x,
+            y,
+            dashed: false,
+            colour: None,
+            gaps: false,
+        }
+    }
+    /// Drawn dashed.
+    pub fn dashed(mut self, on: bool) -> Self {
+        self.dashed = on;
+        self
+    }
+    /// In the palette's colour `k` (several series can share one).
+    pub fn colour(mut self, k: usize) -> Self {
+        self.colour = Some(k);
+        self
+    }
+    /// Non-finite points break the line into pieces.
+    pub fn with_gaps(mut self) -> Self {
+        self.gaps = true;
+        self
     }
 }
 
@@ -164,6 +192,9 @@ struct Prepared<'a> {
     log_x: bool,
     /// label, finite points
     series: Vec<(&'a str, Vec<(f64, f64)>)>,
+    /// Per series: dashed, colour, and the indices in its points where a
+    /// new piece starts (gapped series).
+    looks: Vec<(bool, Option<usize>, Vec<usize>)>,
     peaks: Vec<Peak<'a>>,
     x_range: (f64, f64),
     y_range: (f64, f64),
@@ -178,6 +209,7 @@ impl<'a> Prepared<'a> {
     /// `x_pad`: fractional padding of the x range (0 for signals and spectra).
     fn from_panel(p: &Panel<'a>, x_pad: f64) -> Result<Self, PlotError> {
         let mut series = Vec::with_capacity(p.series.len());
+        let mut looks = Vec::with_capacity(p.series.len());
         for s in &p.series {
             if s.x.len() != s.y.len() {
                 return Err(PlotError::Input(format!(
@@ -187,13 +219,17 @@ impl<'a> Prepared<'a> {
                     s.y.len()
                 )));
             }
-            let pts: Vec<(f64, f64)> =
-                s.x.iter()
-                    .zip(s.y)
-                    .map(|(&x, &y)| (x, y))
-                    .filter(|&(x, y)| x.is_finite() && y.is_finite() && (!p.log_x || x > 0.0))
-                    .collect();
+            let mut pts: Vec<(f64, f64)> = Vec::with_capacity(s.x.len());
+            let mut breaks = Vec::new();
+            for (&x, &y) in s.x.iter().zip(s.y) {
+                if x.is_finite() && y.is_finite() && (!p.log_x || x > 0.0) {
+                    pts.push((x, y));
+                } else if s.gaps && breaks.last() != Some(&pts.len()) {
+                    breaks.push(pts.len());
+                }
+            }
             series.push((s.label, pts));
+            looks.push((s.dashed, s.colour, breaks));
         }
         let all = || series.iter().flat_map(|(_, pts)| pts.iter());
         let xr = min_max(all().map(|p| p.0));
@@ -239,6 +275,7 @@ impl<'a> Prepared<'a> {
             y_label: p.y_label,
             log_x: p.log_x,
             series,
+            looks,
             peaks: p.peaks.clone(),
             x_range,
             y_range,
@@ -348,11 +385,20 @@ where
     let plot_w = (px_range.end - px_range.start).max(1) as usize;
     let mut any_label = false;
     for (k, (label, pts)) in p.series.iter().enumerate() {
-        let color = PALETTE[k % PALETTE.len()];
+        let (dashed, colour, breaks) = &p.looks[k];
+        let color = PALETTE[colour.unwrap_or(k) % PALETTE.len()];
         let dense = pts.len() > 3 * plot_w;
-        // Polylines to draw: the data itself when short, else simplified to the
-        // output resolution (see `decimate`).
-        let polylines: Vec<Vec<(f64, f64)>> = if pts.len() > 2 * plot_w {
+        // Polylines to draw: the data itself when short or broken into
+        // pieces, else simplified to the output resolution (see `decimate`).
+        let polylines: Vec<Vec<(f64, f64)>> = if !breaks.is_empty() {
+            let mut cuts = vec![0];
+            cuts.extend(breaks.iter().copied());
+            cuts.push(pts.len());
+            cuts.windows(2)
+                .filter(|w| w[1] > w[0])
+                .map(|w| pts[w[0]..w[1]].to_vec())
+                .collect()
+        } else if pts.len() > 2 * plot_w {
             let to_px = |x: f64, y: f64| chart.backend_coord(&(x, y));
             let by_column = if p.path_mode {
                 None
@@ -367,27 +413,41 @@ where
             vec![pts.clone()]
         };
         let stroke = color.stroke_width(if dense { 1 } else { theme.px_u(2.0) });
-        let anno = if pts.len() == 1 {
-            chart.draw_series(std::iter::once(Circle::new(
-                pts[0],
-                theme.px(4.0),
-                color.filled(),
-            )))?
-        } else {
+        // A lone point (a piece of one, or a one-point series) is a dot.
+        let (dots, lines): (Vec<_>, Vec<_>) = polylines.into_iter().partition(|l| l.len() == 1);
+        let dot = |l: Vec<(f64, f64)>| Circle::new(l[0], theme.px(4.0), color.filled());
+        let (dash, gap) = (theme.px(8.0), theme.px(5.0));
+        let anno = if *dashed {
             chart.draw_series(
-                polylines
+                lines
                     .into_iter()
-                    .map(|line| PathElement::new(line, stroke)),
+                    .map(|line| DashedPathElement::new(line, dash, gap, stroke)),
             )?
+        } else {
+            chart.draw_series(lines.into_iter().map(|line| PathElement::new(line, stroke)))?
         };
         if !label.is_empty() {
             any_label = true;
             let leg = theme.px(22.0);
             let lw = theme.px_u(3.0);
-            anno.label(*label).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + leg, y)], color.stroke_width(lw))
-            });
+            let style = color.stroke_width(lw);
+            if *dashed {
+                anno.label(*label).legend(move |(x, y)| {
+                    DashedPathElement::new(
+                        vec![(x, y), (x + leg, y)],
+                        theme.px(6.0),
+                        theme.px(4.0),
+                        style,
+                    )
+                    .into_dyn()
+                });
+            } else {
+                anno.label(*label).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + leg, y)], style).into_dyn()
+                });
+            }
         }
+        chart.draw_series(dots.into_iter().map(dot))?;
     }
     if any_label {
         chart

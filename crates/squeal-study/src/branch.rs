@@ -1,15 +1,19 @@
-//! The limit cycle followed in one parameter by natural-parameter
-//! continuation (each point's Newton shooting starts from the previous
-//! cycle; a point where that fails is settled afresh by simulation), with
-//! the changes of stability and of the event structure along the branch.
+//! The limit cycle followed in one parameter by
+//! `squeal_core::cycle::continuation` (pseudo-arclength through folds; grid
+//! values the branch does not reach are settled afresh by simulation), with
+//! the bifurcations along it (folds, period doubling, Neimark–Sacker,
+//! grazing/sliding) and where it meets steady sliding, compared with
+//! `critical`'s Hopf point.
 
 use crate::cycle::{self, Found};
 use crate::error::{Cancel, Progress, StudyError};
 use crate::scenario::{InputError, Scenario};
 use serde_json::{json, Value};
-use squeal_core::cycle::Section;
+use squeal_core::cycle::continuation::{
+    self as cont, BranchOptions, PointKind, Reparametrise, SegmentEnd, Varied,
+};
+use squeal_core::cycle::{find_cycle, CycleError};
 use squeal_core::stability::Crossing;
-use squeal_core::EventKind;
 
 /// `n` evenly spaced values from `lo` to `hi`.
 pub fn values(lo: f64, hi: f64, n: usize) -> Vec<f64> {
@@ -46,12 +50,19 @@ pub fn check(sc: &Scenario, name: &str, values: &[f64]) -> Result<(), StudyError
 /// A followed branch.
 #[derive(Debug, Clone)]
 pub struct Branch {
-    /// The points where a cycle was found, in parameter order.
+    /// The rows: each grid value the branch passes (twice or more where it
+    /// folds back over it) and each fold, segment by segment in the order
+    /// followed.
     pub points: Vec<BranchPoint>,
-    /// `(value, why)` where none was.
+    /// Every computed point, intermediate steps included, for the diagram:
+    /// `(segment, value, amplitude of every state, stable)`.
+    pub curve: Vec<(usize, f64, Vec<f64>, bool)>,
+    /// `(value, why)` where no cycle was found.
     pub failures: Vec<(f64, String)>,
-    /// `(value, next value, what changes)` between neighbouring points.
-    pub bifurcations: Vec<(f64, f64, String)>,
+    /// The bifurcations along the segments.
+    pub bifurcations: Vec<cont::Bifurcation>,
+    /// How each segment (continuation run) ended.
+    pub ends: Vec<SegmentEnd>,
     /// Where steady sliding changes stability in the range (`critical`'s
     /// Hopf point, scanned on 64 points), if it does.
     pub hopf: Option<Crossing>,
@@ -59,7 +70,8 @@ pub struct Branch {
 
 /// Follow the cycle of `sc` over `values` of `name` (checked by [`check`]);
 /// `range` is the interval searched for the Hopf point. `progress` counts
-/// values; `cancel` is looked at between points.
+/// values settled afresh and, at the end, the rest; `cancel` is looked at
+/// before every settling and every system the continuation builds.
 pub fn follow(
     sc: &Scenario,
     name: &str,
@@ -70,53 +82,140 @@ pub fn follow(
 ) -> Result<Branch, StudyError> {
     let opts = cycle::options(sc, 20_000_000, 1000.0);
     let names = sc.model.state_names();
-    let mut points: Vec<BranchPoint> = Vec::with_capacity(values.len());
-    let mut failures = Vec::new();
-    for &v in values {
-        cancel.check()?;
-        let mut p = sc.clone();
-        p.model
-            .set(name, v)
-            .map_err(|e| InputError(e.to_string()))?;
-        let prev = points.last().map(|q| &q.found);
-        let found = continue_from(&p, prev, &names, &opts)
-            .or_else(|_| cycle::of_scenario(&p, &opts, false, cancel));
-        cancel.check()?;
-        match found {
-            Ok(f) => points.push(BranchPoint { value: v, found: f }),
-            Err(e) => failures.push((v, e.to_string())),
-        }
-        progress.inc(1);
-    }
-    let mut bifurcations = Vec::new();
-    for w in points.windows(2) {
-        for what in transition(&w[0].found, &w[1].found) {
-            bifurcations.push((w[0].value, w[1].value, what));
-        }
-    }
+    let bopts = BranchOptions {
+        cycle: opts,
+        ..BranchOptions::default()
+    };
+    let mut settled = 0;
+    let out = crate::with_system!(&sc.model, m => {
+        // The family checks the cancel token each time it builds a system,
+        // so an interrupted continuation fails every step at once.
+        let family = Varied { model: m, name };
+        let guarded = Guarded { inner: &family, cancel };
+        let mut settle = |v: f64| {
+            if cancel.is_cancelled() {
+                return Err(CycleError::Bad("interrupted".into()));
+            }
+            settled += 1;
+            progress.inc(1);
+            let mut out = Err(CycleError::Bad(format!("{name} = {v}: no system")));
+            m.with_param(name, v, &mut |sys| {
+                out = crate::run::initial_of(sys, sc)
+                    .map_err(|e| CycleError::Bad(e.to_string()))
+                    .and_then(|z0| find_cycle(sys, 0.0, z0, &opts));
+            })
+            .map_err(CycleError::Bad)?;
+            out
+        };
+        let b = cont::branch(&guarded, values, &mut settle, &bopts);
+        Ok(collect(&b, &names))
+    }, else => Err(StudyError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))));
+    cancel.check()?;
+    progress.inc(values.len().saturating_sub(settled) as u64);
+    let (points, curve, failures, bifurcations, ends) = out?;
     let hopf = crate::critical::locate(&sc.model, name, range.0, range.1, 64, cancel)
         .ok()
         .flatten();
     cancel.check()?;
     Ok(Branch {
         points,
+        curve,
         failures,
         bifurcations,
+        ends,
         hopf,
     })
 }
 
+/// A family that fails once `cancel` is set.
+struct Guarded<'a, F: ?Sized> {
+    inner: &'a F,
+    cancel: &'a Cancel,
+}
+
+impl<F: cont::Family<N> + ?Sized, const N: usize> cont::Family<N> for Guarded<'_, F> {
+    fn visit(&self, p: f64, f: &mut dyn FnMut(&dyn squeal_core::System<N>)) -> Result<(), String> {
+        if self.cancel.is_cancelled() {
+            return Err("interrupted".into());
+        }
+        self.inner.visit(p, f)
+    }
+}
+
+type Collected = (
+    Vec<BranchPoint>,
+    Vec<(usize, f64, Vec<f64>, bool)>,
+    Vec<(f64, String)>,
+    Vec<cont::Bifurcation>,
+    Vec<SegmentEnd>,
+);
+
+fn collect<const N: usize>(b: &cont::Branch<N>, names: &[String]) -> Collected {
+    let mut points = Vec::new();
+    let mut curve = Vec::new();
+    for p in &b.points {
+        curve.push((
+            p.segment,
+            p.value,
+            p.cycle.amplitude.to_vec(),
+            p.cycle.stable,
+        ));
+        let kind = match p.kind {
+            PointKind::Grid(_) => "grid",
+            PointKind::Fold => "fold",
+            PointKind::Step => continue,
+        };
+        points.push(BranchPoint {
+            value: p.value,
+            found: cycle::found_of(&p.cycle, names.to_vec()),
+            kind,
+            segment: p.segment,
+        });
+    }
+    let failures = b
+        .failures
+        .iter()
+        .map(|(v, e)| (*v, format!("cycle: {e}")))
+        .collect();
+    (
+        points,
+        curve,
+        failures,
+        b.bifurcations.clone(),
+        b.ends.clone(),
+    )
+}
+
 impl Branch {
+    /// Where segments shrink onto steady sliding: `(value, frequency in Hz)`
+    /// extrapolated in the squared amplitude.
+    pub fn steady_sliding(&self) -> Vec<(f64, f64)> {
+        self.ends
+            .iter()
+            .filter_map(|e| match e {
+                SegmentEnd::SteadySliding { value, freq_hz } => Some((*value, *freq_hz)),
+                _ => None,
+            })
+            .collect()
+    }
+
     /// The document `summary.json` holds: `param`, `points` (each cycle's
-    /// JSON with its `value`), `bifurcations`, `failed`, `hopf` (with the
-    /// branch's point nearest to it) and the `scenario`.
+    /// JSON with its `value`, `point` (`grid` or `fold`) and `segment`),
+    /// `bifurcations` (`kind`, `between`, `value`, `detail`), `segments` (how
+    /// each ended), `failed`, `hopf` (with the branch's point nearest to it
+    /// and the branch's own end on steady sliding, `branch_end`) and the
+    /// `scenario`.
     pub fn to_json(&self, name: &str, sc: &Scenario) -> Value {
+        let steady = self.steady_sliding();
         let hopf = self.hopf.as_ref().map(|c| {
             let near = self.points.iter().min_by(|p, q| {
                 (p.value - c.value)
                     .abs()
                     .total_cmp(&(q.value - c.value).abs())
             });
+            let end = steady
+                .iter()
+                .min_by(|a, b| (a.0 - c.value).abs().total_cmp(&(b.0 - c.value).abs()));
             json!({
                 "value": c.value,
                 "freq_hz": c.freq_hz,
@@ -125,16 +224,44 @@ impl Branch {
                     "cycle_freq_hz": 1.0 / p.found.period,
                     "max_multiplier": p.found.max_multiplier,
                 })),
+                "branch_end": end.map(|&(v, f)| json!({
+                    "value": v,
+                    "freq_hz": f,
+                    "value_difference": v - c.value,
+                    "freq_difference_hz": f - c.freq_hz,
+                })),
             })
         });
+        let segments: Vec<Value> = self
+            .ends
+            .iter()
+            .map(|e| match e {
+                SegmentEnd::LeftRange => json!({ "end": "left_range" }),
+                SegmentEnd::Steps => json!({ "end": "steps" }),
+                SegmentEnd::Stalled { value, cause } => {
+                    json!({ "end": "stalled", "value": value, "cause": cause })
+                }
+                SegmentEnd::SteadySliding { value, freq_hz } => {
+                    json!({ "end": "steady_sliding", "value": value, "freq_hz": freq_hz })
+                }
+            })
+            .collect();
         json!({
             "param": name,
             "points": self.points.iter().map(|p| {
                 let mut v = p.found.to_json();
                 v["value"] = json!(p.value);
+                v["point"] = json!(p.kind);
+                v["segment"] = json!(p.segment);
                 v
             }).collect::<Vec<_>>(),
-            "bifurcations": self.bifurcations.iter().map(|(a, b, what)| json!({ "between": [a, b], "kind": what })).collect::<Vec<_>>(),
+            "bifurcations": self.bifurcations.iter().map(|x| json!({
+                "kind": x.kind.as_str(),
+                "between": [x.between.0, x.between.1],
+                "value": x.value,
+                "detail": x.detail,
+            })).collect::<Vec<_>>(),
+            "segments": segments,
             "failed": self.failures.iter().map(|(v, e)| json!({ "value": v, "error": e })).collect::<Vec<_>>(),
             "hopf": hopf,
             "scenario": sc.to_json(),
@@ -142,81 +269,15 @@ impl Branch {
     }
 }
 
-/// One point of the branch.
+/// One row of the branch.
 #[derive(Debug, Clone)]
 pub struct BranchPoint {
     /// The parameter's value.
     pub value: f64,
     /// The cycle there.
     pub found: Found,
-}
-
-/// What changes between two neighbouring points: a bifurcation's name.
-pub fn transition(a: &Found, b: &Found) -> Vec<String> {
-    let mut out = Vec::new();
-    if a.events != b.events {
-        let show = |e: &[u64; 5]| {
-            EventKind::ALL
-                .iter()
-                .filter(|k| e[k.index()] > 0)
-                .map(|k| format!("{} {}", e[k.index()], k.as_str()))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        out.push(format!(
-            "grazing/sliding: the events per period change ({} → {})",
-            show(&a.events),
-            show(&b.events)
-        ));
-    }
-    if a.stable != b.stable {
-        // The multiplier that crossed the unit circle: the largest non-trivial
-        // one on the unstable side.
-        let side = if a.stable { b } else { a };
-        let crit = side
-            .multipliers
-            .iter()
-            .filter(|m| !m.2)
-            .max_by(|x, y| x.0.hypot(x.1).total_cmp(&y.0.hypot(y.1)));
-        let kind = match crit {
-            Some(&(re, im, _)) if im.abs() > 1e-9 * re.hypot(im) => "Neimark–Sacker",
-            Some(&(re, _, _)) if re < 0.0 => "period doubling",
-            _ => "fold (a real multiplier through +1)",
-        };
-        out.push(format!(
-            "{kind}: stability {} → {}",
-            if a.stable { "stable" } else { "unstable" },
-            if b.stable { "stable" } else { "unstable" }
-        ));
-    }
-    if (b.period / a.period - 1.0).abs() > 0.5 {
-        out.push(format!(
-            "the period jumps ({:.6e} → {:.6e} s): another cycle",
-            a.period, b.period
-        ));
-    }
-    out
-}
-
-/// Newton shooting from the previous point's cycle.
-fn continue_from(
-    sc: &Scenario,
-    prev: Option<&Found>,
-    names: &[String],
-    opts: &squeal_core::cycle::CycleOptions,
-) -> Result<Found, StudyError> {
-    let Some(prev) = prev else {
-        return Err(StudyError::Numerical("no previous point".into()));
-    };
-    let index = names
-        .iter()
-        .position(|n| *n == prev.section.0)
-        .ok_or_else(|| StudyError::Numerical("section lost".into()))?;
-    let section = Section {
-        index,
-        level: prev.section.1,
-    };
-    crate::with_system!(&sc.model, m => {
-        cycle::find(m, &sc.model, &prev.z0, Some((&prev.z0, prev.period, section)), opts, false)
-    }, else => Err(StudyError::Numerical("not simulable".into())))
+    /// `grid` (one of the evenly spaced values) or `fold`.
+    pub kind: &'static str,
+    /// The continuation run it belongs to.
+    pub segment: usize,
 }

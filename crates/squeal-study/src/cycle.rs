@@ -136,7 +136,14 @@ pub fn find<M: System<N> + ?Sized, const N: usize>(
     } else {
         None
     };
-    Ok(Found {
+    let mut found = found_of(&c, names);
+    found.orbit = orbit;
+    Ok(found)
+}
+
+/// The N-independent form of a located cycle (no orbit table).
+pub fn found_of<const N: usize>(c: &cycle::Cycle<N>, names: Vec<String>) -> Found {
+    Found {
         period: c.period,
         z0: c.z0.to_vec(),
         section: (names[c.section.index].clone(), c.section.level),
@@ -152,9 +159,9 @@ pub fn find<M: System<N> + ?Sized, const N: usize>(
         amplitude: c.amplitude.to_vec(),
         events: c.events_per_period,
         settle_time: c.settle_time,
-        orbit,
+        orbit: None,
         names,
-    })
+    }
 }
 
 /// The cycle of a scenario, from its initial state. `cancel` is looked at

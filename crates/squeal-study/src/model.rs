@@ -170,6 +170,9 @@ impl AnyModel {
     /// Full stability analysis with mass-weighted mode attribution.
     pub fn analyse(&self) -> Result<Analysis, StabilityError> {
         match self {
+            AnyModel::Lumped(l) if l.modal.projects(l.dof_count()) => {
+                stability::lumped::analyse(l, Some(&l.diagonal_masses()))
+            }
             AnyModel::Lumped(l) => {
                 let masses = l.diagonal_masses();
                 squeal_core::with_lumped_size!(&**l,
@@ -182,6 +185,11 @@ impl AnyModel {
     }
     /// Largest growth rate of steady sliding and its frequency (the fast path of maps).
     pub fn max_growth_rate(&self) -> Result<(f64, f64), StabilityError> {
+        if let AnyModel::Lumped(l) = self {
+            if l.modal.projects(l.dof_count()) {
+                return stability::lumped::max_growth_rate(l);
+            }
+        }
         crate::with_system!(self, m => stability::max_growth_rate(m),
         else => match self {
             AnyModel::Lumped(l) => stability::lumped::max_growth_rate(l),

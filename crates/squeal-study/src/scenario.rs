@@ -342,6 +342,15 @@ impl Scenario {
             match (key.as_str(), value) {
                 ("model", _) => {}
                 (k, _) if lumped && LUMPED_KEYS.contains(&k) => {}
+                ("modal", toml::Value::Table(t)) if lumped => {
+                    // The eigen-analysis options: `[modal] modes = 200` is `--set modal.modes=200`.
+                    for (k, v) in t {
+                        let setting = Setting::from_toml(v).ok_or_else(|| {
+                            InputError(format!("modal.{k} = {v}: expected a number"))
+                        })?;
+                        s.apply_in("params", &format!("modal.{k}"), &setting)?;
+                    }
+                }
                 ("params" | "friction", _) if lumped => {
                     return err(format!(
                         "{key}: a lumped model takes its parameters in its elements ([[spring]], [[contact]], …)"

@@ -56,6 +56,7 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
         "least_stable": { "re": ls.re, "im": ls.im, "freq_hz": ls.freq_hz, "dominant": ls.dominant_name },
         "equilibrium": eq,
         "shape_normalisation": SHAPE_NORMALISATION,
+        "modal": modal_json(an),
     })
 }
 
@@ -86,6 +87,30 @@ pub fn document(sc: &crate::Scenario, an: &Analysis, levers: &[Lever]) -> Value 
         .map(|l| json!({ "param": l.param, "from": l.from, "to": l.to, "freq_hz": l.freq_hz }))
         .collect::<Vec<_>>());
     doc
+}
+
+/// How a study of `model` (a critical value, a map: one eigen-analysis per
+/// point) computes its eigenvalues: `{"method": "dense"}`, or for a lumped
+/// model above `modal.dense_max_dofs` `{"method": "projected",
+/// "dense_max_dofs": …, "modes": …, "cutoff_hz": …}` (the basis is rebuilt
+/// at every point).
+pub fn modal_options_json(model: &AnyModel) -> Value {
+    match model {
+        AnyModel::Lumped(l) if l.modal.projects(l.dof_count()) => json!({
+            "method": "projected",
+            "dense_max_dofs": l.modal.dense_max_dofs,
+            "modes": l.modal.modes,
+            "cutoff_hz": l.modal.cutoff_hz,
+        }),
+        _ => json!({ "method": "dense" }),
+    }
+}
+
+/// How the eigenvalues were computed: `{"method": "dense"}` or
+/// `{"method": "projected", "modes": m, "dofs": n, "basis_max_hz": f}`
+/// (a reduced-basis answer for the modes in that band).
+pub fn modal_json(an: &Analysis) -> Value {
+    serde_json::to_value(an.method).unwrap_or(Value::Null)
 }
 
 /// `stable` (every σ < 0 beyond round-off), `neutral` (no mode grows, some

@@ -110,7 +110,7 @@ fn coulomb_belt_branch_over_v_is_exact() {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "V,period,amplitude_x,amplitude_v,max_multiplier,stable,events_stick,events_slip,events_reverse,events_separate,events_contact"
+        "V,period,amplitude_x,amplitude_v,max_multiplier,stable,events_stick,events_slip,events_reverse,events_separate,events_contact,point"
     );
     let (omega, xi) = (100.0f64, 0.001f64);
     let mut rows = 0;
@@ -133,4 +133,88 @@ fn coulomb_belt_branch_over_v_is_exact() {
     }
     assert_eq!(rows, 8);
     assert!(d.path().join("b/branch.png").is_file());
+}
+
+/// `squeal branch` on the belt with `μ(v) = 0.5 + 0.5 exp(−v²)`, m = k = N = 1.
+fn gaussian_branch(dir: &Path, c: &str, range: &str, out: &str) -> serde_json::Value {
+    let o = squeal(
+        dir,
+        &[
+            "branch",
+            "belt",
+            "--set",
+            "friction=stribeck",
+            "--set",
+            "mu_s=1",
+            "--set",
+            "mu_k=0.5",
+            "--set",
+            "v_s=1",
+            "--set",
+            "delta=2",
+            "--set",
+            "sigma=0",
+            "--set",
+            "m=1",
+            "--set",
+            "k=1",
+            "--set",
+            "N=1",
+            "--set",
+            c,
+            "--param",
+            range,
+            "--out",
+            out,
+            "--json",
+        ],
+    );
+    json_of(&o)
+}
+
+#[test]
+fn branch_folds_and_meets_criticals_hopf_point() {
+    let d = tempfile::tempdir().unwrap();
+    // Subcritical Hopf (c = 0.2): the stable cycle folds near V = 1.4575 into
+    // the unstable one that shrinks onto steady sliding at the Hopf speed.
+    let doc = gaussian_branch(d.path(), "c=0.2", "V=1.2:2.0:5", "fold");
+    let kinds: Vec<&str> = doc["bifurcations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b["kind"].as_str().unwrap())
+        .collect();
+    assert!(
+        kinds.contains(&"fold") && kinds.contains(&"grazing_sliding"),
+        "{kinds:?}"
+    );
+    let csv = std::fs::read_to_string(d.path().join("fold/branch.csv")).unwrap();
+    let folds: Vec<&str> = csv.lines().filter(|l| l.ends_with(",fold")).collect();
+    assert_eq!(folds.len(), 1, "{csv}");
+    let v_fold: f64 = folds[0].split(',').next().unwrap().parse().unwrap();
+    assert!((1.45..1.47).contains(&v_fold), "{v_fold}");
+    // V = 1.4 twice: the stable cycle and the unstable one.
+    assert_eq!(csv.lines().filter(|l| l.starts_with("1.4e0,")).count(), 2);
+    assert!(d.path().join("fold/branch.png").is_file());
+    // The branch's end on steady sliding and critical's Hopf point agree.
+    for (doc, what) in [
+        (doc, "subcritical"),
+        // Supercritical Hopf (c = 0.35, μ''' > 0 at V_H ≈ 1.0466): a small
+        // smooth cycle below V_H.
+        (
+            gaussian_branch(d.path(), "c=0.35", "V=0.95:1.05:3", "super"),
+            "supercritical",
+        ),
+    ] {
+        let h = &doc["hopf"];
+        let v_h = h["value"].as_f64().unwrap();
+        let end = &h["branch_end"];
+        let dv = end["value_difference"].as_f64().unwrap();
+        let df = end["freq_difference_hz"].as_f64().unwrap();
+        assert!(dv.abs() <= 1e-5 * v_h, "{what}: {dv}");
+        // The linear frequency at the Hopf point: √(k/m)/2π.
+        let f = 0.5 / std::f64::consts::PI;
+        assert!(df.abs() <= 1e-6 * f, "{what}: {df}");
+        assert!((h["freq_hz"].as_f64().unwrap() - f).abs() <= 1e-6 * f);
+    }
 }

@@ -272,6 +272,79 @@ mu_k = 0.3
     ));
     let (x, y) = (a["value"].as_f64().unwrap(), b["value"].as_f64().unwrap());
     assert!((x - y).abs() <= 1e-9 * y, "critical μ {x} vs {y}");
+    // The projected analysis on the 20 lowest undamped modes: K_s is block
+    // diagonal (Hoffmann's block, then the decoupled dofs) and the block's
+    // two modes are among the 20 lowest, so the basis holds the block
+    // exactly and the critical μ is the same.
+    let projected = ["--set", "modal.dense_max_dofs=0", "--set", "modal.modes=20"];
+    let mut args = vec![
+        "critical",
+        "big.toml",
+        "--param",
+        "belt.mu_k=0.01:1",
+        "--grid",
+        "12",
+        "--json",
+    ];
+    args.extend(projected);
+    let p = json(&squeal(d.path(), &args));
+    let z = p["value"].as_f64().unwrap();
+    assert!((z - y).abs() <= 1e-9 * y, "projected critical μ {z} vs {y}");
+    assert_eq!(p["modal"]["method"], "projected");
+    assert_eq!(p["modal"]["modes"], 20);
+    assert_eq!(a["modal"]["method"], "dense");
+    let mut args = vec!["stability", "big.toml", "--json"];
+    args.extend(projected);
+    let s = json(&squeal(d.path(), &args));
+    assert_eq!(s["modal"]["method"], "projected");
+    assert_eq!(s["modal"]["modes"], 20);
+    assert_eq!(s["modal"]["dofs"], n);
+    assert_eq!(s["eigenvalues"].as_array().unwrap().len(), 40);
+    let dense = json(&squeal(d.path(), &["stability", "big.toml", "--json"]));
+    assert_eq!(dense["modal"]["method"], "dense");
+    assert_eq!(dense["eigenvalues"].as_array().unwrap().len(), 2 * n);
+    let human = ok(&squeal(
+        d.path(),
+        &[
+            "stability",
+            "big.toml",
+            "--set",
+            "modal.dense_max_dofs=0",
+            "--set",
+            "modal.modes=20",
+        ],
+    ));
+    assert!(
+        human.contains("projected onto the 20 lowest undamped modes of 300 dofs"),
+        "{human}"
+    );
+    // The same options from the file's [modal] table.
+    let text = std::fs::read_to_string(d.path().join("big.toml")).unwrap();
+    std::fs::write(
+        d.path().join("big-modal.toml"),
+        format!("{text}\n[modal]\ndense_max_dofs = 0\nmodes = 20\n"),
+    )
+    .unwrap();
+    let f = json(&squeal(
+        d.path(),
+        &["stability", "big-modal.toml", "--json"],
+    ));
+    assert_eq!(f["modal"], s["modal"]);
+    assert_eq!(f["eigenvalues"], s["eigenvalues"]);
+    std::fs::write(
+        d.path().join("bad-modal.toml"),
+        format!("{text}\n[modal]\nshift = 3\n"),
+    )
+    .unwrap();
+    let out = squeal(d.path(), &["stability", "bad-modal.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("modal.shift"));
+    let out = squeal(
+        d.path(),
+        &["stability", "big.toml", "--set", "modal.modes=2.5"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("modal.modes"));
     // Simulation is refused for a model this size, with the limit stated.
     let out = squeal(d.path(), &["simulate", "big.toml", "--out", "x"]);
     assert_eq!(out.status.code(), Some(2));

@@ -41,6 +41,8 @@
 //! position amplitude, velocities by its velocity amplitude), so that the
 //! eigenvalues do not suffer from the state's units (MODEL.md §8).
 
+pub mod continuation;
+
 use crate::integrate::{IntegrateError, Solver, SolverOptions};
 use crate::model::{EventKind, Guards, Modes, System};
 use nalgebra::DMatrix;
@@ -123,6 +125,9 @@ pub enum CycleError {
     /// Bad settings.
     #[error("{0}")]
     Bad(String),
+    /// The oscillation found is too small to be a cycle of the branch.
+    #[error("no cycle: {0}")]
+    Vanishing(String),
 }
 
 /// One Floquet multiplier.
@@ -339,6 +344,7 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
     let mut j1 = DMatrix::<f64>::zeros(N, N);
     let mut j2 = DMatrix::<f64>::zeros(N, N);
     let mut events = [0u64; 5];
+    let mut last_switch: Option<(f64, [u64; 5], Modes)> = None;
     let mut lo = *z0;
     let mut hi = *z0;
     let g = 3f64.sqrt() / 6.0;
@@ -419,9 +425,6 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
                 let sm = saltation(sys, seg.t1, &seg.modes, &z_m, &modes_p, &z_p, s);
                 phi = sm * phi;
             }
-            if let Some(ev) = seg.event {
-                events[ev.index()] += 1;
-            }
             if let Some(o) = orbit.as_deref_mut() {
                 o.t.push(seg.t1 - t_a);
                 o.z.push(z_m);
@@ -432,8 +435,14 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
                 o.modes.push(modes_p);
                 o.event.push(seg.event.map(|e| (e, seg.contact)));
             }
+            // This switch's events: the located one and those fired while
+            // the mode settled after it.
+            let mut fired = [0u64; 5];
+            if let Some(ev) = seg.event {
+                fired[ev.index()] += 1;
+            }
             while let Some((ev, c, _, _)) = solver.take_pending_contact_event() {
-                events[ev.index()] += 1;
+                fired[ev.index()] += 1;
                 if let Some(o) = orbit.as_deref_mut() {
                     if let Some(last) = o.event.last_mut() {
                         if last.is_none() {
@@ -441,6 +450,23 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
                         }
                     }
                 }
+            }
+            // Counted unless they change no mode, or undo the switch just
+            // before at the same instant (a zero-duration excursion, e.g. a
+            // slip and an immediate re-stick at breakaway): the structure of
+            // the orbit is counted, not the integrator's path through it.
+            let undo = last_switch
+                .filter(|(t, _, before)| (seg.t1 - t).abs() <= 1e-9 * period && *before == modes_p);
+            if let Some((_, prev, _)) = undo {
+                for k in 0..5 {
+                    events[k] = events[k].saturating_sub(prev[k]);
+                }
+                last_switch = None;
+            } else if modes_p != seg.modes {
+                for k in 0..5 {
+                    events[k] += fired[k];
+                }
+                last_switch = Some((seg.t1, fired, seg.modes));
             }
         }
     }

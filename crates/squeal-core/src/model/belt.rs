@@ -5,8 +5,8 @@
 //! State `z = (x, ẋ)`.
 
 use super::{
-    friction_event, stick_or_slip, EventKind, GuardKind, Guards, Mode, Model, ModelError,
-    Observables, Parameters,
+    contact, stick_or_slip, EventKind, GuardKind, Guards, Mode, Model, ModelError, Observables,
+    Parameters,
 };
 use crate::friction::FrictionLaw;
 use crate::params::{ParamError, ParamKind, ParamSpec};
@@ -129,16 +129,21 @@ impl Model<2> for Belt {
     fn guards(&self, mode: Mode, out: &mut Guards<2>) {
         out.clear();
         let p = &self.p;
-        let bound = self.friction.mu_static() * p.N;
         match mode {
             Mode::SlipPos | Mode::SlipNeg => {
-                // g = −s·v = −s(V − ẋ).
-                let s = mode.slip_sign();
-                out.push(GuardKind::SlipZero, [0.0, s], -s * p.V);
+                // v = V − ẋ.
+                let (c, d) = contact::slip_zero_guard(mode, &([0.0, -1.0], p.V));
+                out.push(GuardKind::SlipZero, c, d);
             }
             Mode::Stick => {
-                out.push(GuardKind::StickBreakPos, [p.k, p.c], -bound);
-                out.push(GuardKind::StickBreakNeg, [-p.k, -p.c], -bound);
+                // ±(k x + c ẋ) − μ_s N, the load N prescribed.
+                let fs = ([p.k, p.c], 0.0);
+                let normal = ([0.0, 0.0], p.N);
+                for (kind, (c, d)) in
+                    contact::stick_break_guards(&fs, &normal, self.friction.mu_static())
+                {
+                    out.push(kind, c, d);
+                }
             }
             Mode::Free => {}
         }
@@ -150,26 +155,24 @@ impl Model<2> for Belt {
         guard: GuardKind,
         z: &mut [f64; 2],
     ) -> (Mode, Option<EventKind>) {
-        match guard {
-            GuardKind::SlipZero => {
-                z[1] = self.p.V;
-                let next = stick_or_slip(self.stick_force(z), self.friction.mu_static() * self.p.N);
-                (next, friction_event(mode, next))
-            }
-            GuardKind::StickBreakPos => (Mode::SlipPos, Some(EventKind::Slip)),
-            GuardKind::StickBreakNeg => (Mode::SlipNeg, Some(EventKind::Slip)),
-            GuardKind::Separation | GuardKind::Contact => (mode, None),
+        if matches!(guard, GuardKind::Separation | GuardKind::Contact) {
+            // The load is prescribed: the belt never pushes these guards.
+            return (mode, None);
         }
+        if guard == GuardKind::SlipZero {
+            z[1] = self.p.V;
+        }
+        let z = &*z;
+        contact::after_guard(guard, mode, || {
+            stick_or_slip(self.stick_force(z), self.friction.mu_static() * self.p.N)
+        })
     }
     fn initial_mode(&self, _t: f64, z: &[f64; 2]) -> Mode {
-        let v = self.p.V - z[1];
-        if v > 0.0 {
-            Mode::SlipPos
-        } else if v < 0.0 {
-            Mode::SlipNeg
-        } else {
-            stick_or_slip(self.stick_force(z), self.friction.mu_static() * self.p.N)
-        }
+        contact::friction_mode(
+            self.p.V - z[1],
+            self.stick_force(z),
+            self.friction.mu_static() * self.p.N,
+        )
     }
     fn observe(&self, _t: f64, mode: Mode, z: &[f64; 2]) -> Observables {
         let v_rel = self.p.V - z[1];

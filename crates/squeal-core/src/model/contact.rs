@@ -3,10 +3,111 @@
 //! Kelvin–Voigt layer `F_n = k·δ + c·δ̇` on a compression `δ = n·q`, unilateral
 //! or bilateral, or a prescribed load), a sliding velocity `v = V + t·q̇`, a
 //! friction law μ(|v|) and an optional follower force. Its mode is slip+,
-//! slip−, stick or free; the decisions at `v = 0` ([`stick_or_slip`]) and the
-//! event names ([`friction_event`]) are shared with the hand-written models.
+//! slip−, stick or free.
+//!
+//! The transition logic of a contact is here once, for every model — the
+//! hand-written disc–pad, belt and Hoffmann models and the lumped models:
+//!
+//! - [`friction_mode`]: the mode of a contact that touches, from the sign of
+//!   its sliding velocity, and at `v = 0` stick or slip by the force needed
+//!   to stick ([`stick_or_slip`], MODEL.md §4);
+//! - the guards of a mode as affine functions `g = c·z + d` of the state
+//!   (an event when `g` crosses zero upwards): [`slip_zero_guard`] (`−s·v`),
+//!   [`stick_break_guards`] (`±F_s − μ_s·F_n`), [`separation_guard`]
+//!   (`−F_n`); an open contact's guard is its closing quantity itself;
+//! - [`after_guard`]: the next mode and the event when a guard fires
+//!   ([`friction_event`] names friction events).
+//!
+//! A model supplies only what is its own: the affine forms of its sliding
+//! velocity, normal force and stick force, and where the state is projected
+//! onto a switching surface.
 
-use super::{friction_event, stick_or_slip, EventKind, Mode};
+use super::{friction_event, stick_or_slip, EventKind, GuardKind, Mode};
+
+/// An affine function of the state `g(z) = c·z + d`: `(c, d)`.
+pub type Affine<const N: usize> = ([f64; N], f64);
+
+/// The friction mode of a contact that touches: slip+ for `v > 0`, slip−
+/// for `v < 0`, and at `v = 0` stick if the force needed to stick,
+/// `f_stick`, is within `bound = μ_s·max(F_n, 0)`, else slip in its
+/// direction ([`stick_or_slip`]).
+#[inline]
+pub fn friction_mode(v: f64, f_stick: f64, bound: f64) -> Mode {
+    if v > 0.0 {
+        Mode::SlipPos
+    } else if v < 0.0 {
+        Mode::SlipNeg
+    } else {
+        stick_or_slip(f_stick, bound)
+    }
+}
+
+/// The guard of a slip mode: `g = −s·v` (s = ±1 the slip direction), which
+/// crosses zero upwards when the sliding velocity `v = c·z + d` reaches
+/// zero. Zero coefficients stay zero.
+#[inline]
+pub fn slip_zero_guard<const N: usize>(mode: Mode, v: &Affine<N>) -> Affine<N> {
+    let s = mode.slip_sign();
+    let mut c = [0.0; N];
+    for (ci, vi) in c.iter_mut().zip(&v.0) {
+        if *vi != 0.0 {
+            *ci = -s * vi;
+        }
+    }
+    (c, -s * v.1)
+}
+
+/// The two guards of stick, `+F_s − μ_s·F_n` ([`GuardKind::StickBreakPos`])
+/// and `−F_s − μ_s·F_n` ([`GuardKind::StickBreakNeg`]), for a stick force
+/// `F_s` and the normal force carrying friction `F_n`, both affine.
+#[inline]
+pub fn stick_break_guards<const N: usize>(
+    f_stick: &Affine<N>,
+    f_n: &Affine<N>,
+    mu_s: f64,
+) -> [(GuardKind, Affine<N>); 2] {
+    let mut up = [0.0; N];
+    let mut dn = [0.0; N];
+    for i in 0..N {
+        up[i] = f_stick.0[i] - mu_s * f_n.0[i];
+        dn[i] = -f_stick.0[i] - mu_s * f_n.0[i];
+    }
+    [
+        (GuardKind::StickBreakPos, (up, f_stick.1 - mu_s * f_n.1)),
+        (GuardKind::StickBreakNeg, (dn, -f_stick.1 - mu_s * f_n.1)),
+    ]
+}
+
+/// The guard of a contact that can open: `−F_n`, crossing zero upwards when
+/// the normal force falls to zero.
+#[inline]
+pub fn separation_guard<const N: usize>(f_n: &Affine<N>) -> Affine<N> {
+    (f_n.0.map(|x| -x), 0.0 - f_n.1)
+}
+
+/// The next mode of a contact and the event when its `guard` fires in
+/// `mode`: at a zero of the sliding velocity, `decide()` (called on the
+/// switching surface, e.g. [`friction_mode`] with `v = 0`) and the friction
+/// event if the mode changed (stick, slip, reverse); stick breaks into the
+/// slip of its sign; separation frees the contact; on closing, `decide()`
+/// gives the friction mode in contact.
+#[inline]
+pub fn after_guard(
+    guard: GuardKind,
+    mode: Mode,
+    decide: impl FnOnce() -> Mode,
+) -> (Mode, Option<EventKind>) {
+    match guard {
+        GuardKind::SlipZero => {
+            let next = decide();
+            (next, friction_event(mode, next))
+        }
+        GuardKind::StickBreakPos => (Mode::SlipPos, Some(EventKind::Slip)),
+        GuardKind::StickBreakNeg => (Mode::SlipNeg, Some(EventKind::Slip)),
+        GuardKind::Separation => (Mode::Free, Some(EventKind::Separate)),
+        GuardKind::Contact => (decide(), Some(EventKind::Contact)),
+    }
+}
 use crate::friction::FrictionLaw;
 
 /// A linear combination `Σ coef_k·x_{idx_k}` of degrees of freedom (sparse).
@@ -166,13 +267,7 @@ impl Contact {
     /// stick is within the bound, else slip its way (MODEL.md §4).
     #[inline]
     pub fn mode_for(&self, v: f64, f_stick: f64, f_n: f64) -> Mode {
-        if v > 0.0 {
-            Mode::SlipPos
-        } else if v < 0.0 {
-            Mode::SlipNeg
-        } else {
-            stick_or_slip(f_stick, self.stick_bound(f_n))
-        }
+        friction_mode(v, f_stick, self.stick_bound(f_n))
     }
     /// The event for `from → to` at `v = 0`.
     pub fn event(from: Mode, to: Mode) -> Option<EventKind> {

@@ -5,8 +5,8 @@
 //! State `z = (x_d, x_p, y_d, y_p, ẋ_d, ẋ_p, ẏ_d, ẏ_p)`.
 
 use super::{
-    friction_event, stick_or_slip, EventKind, GuardKind, Guards, Mode, Model, ModelError,
-    Observables, Parameters,
+    contact, stick_or_slip, EventKind, GuardKind, Guards, Mode, Model, ModelError, Observables,
+    Parameters,
 };
 use crate::friction::FrictionLaw;
 use crate::params::{ParamError, ParamKind, ParamSpec};
@@ -279,15 +279,17 @@ impl DiscPad {
 
     /// Friction mode for a state in contact, from the sign of v (stick test at v = 0).
     fn friction_mode(&self, z: &[f64; 8]) -> Mode {
-        let v = self.sliding_velocity(z);
-        if v > 0.0 {
-            Mode::SlipPos
-        } else if v < 0.0 {
-            Mode::SlipNeg
-        } else {
-            let f_n = self.friction_normal(self.layer_force(z)).max(0.0);
-            stick_or_slip(self.stick_force(z).0, self.friction.mu_static() * f_n)
-        }
+        contact::friction_mode(
+            self.sliding_velocity(z),
+            self.stick_force(z).0,
+            self.stick_bound(z),
+        )
+    }
+
+    /// `μ_s·max(F_n, 0)` with `F_n` the normal force carrying friction.
+    #[inline]
+    fn stick_bound(&self, z: &[f64; 8]) -> f64 {
+        self.friction.mu_static() * self.friction_normal(self.layer_force(z)).max(0.0)
     }
 }
 
@@ -378,7 +380,7 @@ impl Model<8> for DiscPad {
 
     fn guards(&self, mode: Mode, out: &mut Guards<8>) {
         out.clear();
-        let fy = self.layer_force_grad();
+        let fy = (self.layer_force_grad(), 0.0);
         if mode == Mode::Free {
             // Gap closes: δ = y_d − y_p crosses zero upwards.
             let mut c = [0.0; 8];
@@ -388,28 +390,25 @@ impl Model<8> for DiscPad {
             return;
         }
         if self.contact == Contact::Unilateral {
-            out.push(GuardKind::Separation, fy.map(|x| -x), 0.0);
+            let (c, d) = contact::separation_guard(&fy);
+            out.push(GuardKind::Separation, c, d);
         }
         match mode {
             Mode::SlipPos | Mode::SlipNeg => {
-                // g = −s·v = −s(V + ẋ_d − ẋ_p).
-                let s = mode.slip_sign();
+                // v = V + ẋ_d − ẋ_p.
                 let mut c = [0.0; 8];
-                c[UD] = -s;
-                c[UP] = s;
-                out.push(GuardKind::SlipZero, c, -s * self.p.V);
+                c[UD] = 1.0;
+                c[UP] = -1.0;
+                let (c, d) = contact::slip_zero_guard(mode, &(c, self.p.V));
+                out.push(GuardKind::SlipZero, c, d);
             }
             Mode::Stick => {
-                let fs = self.stick_force_grad();
-                let mu_s = self.friction.mu_static();
-                let mut up = [0.0; 8];
-                let mut dn = [0.0; 8];
-                for i in 0..8 {
-                    up[i] = fs[i] - mu_s * fy[i];
-                    dn[i] = -fs[i] - mu_s * fy[i];
+                let fs = (self.stick_force_grad(), 0.0);
+                for (kind, (c, d)) in
+                    contact::stick_break_guards(&fs, &fy, self.friction.mu_static())
+                {
+                    out.push(kind, c, d);
                 }
-                out.push(GuardKind::StickBreakPos, up, 0.0);
-                out.push(GuardKind::StickBreakNeg, dn, 0.0);
             }
             Mode::Free => unreachable!(),
         }
@@ -422,19 +421,18 @@ impl Model<8> for DiscPad {
         guard: GuardKind,
         z: &mut [f64; 8],
     ) -> (Mode, Option<EventKind>) {
-        match guard {
-            GuardKind::SlipZero => {
-                // On the surface v = 0 exactly.
-                z[UP] = self.p.V + z[UD];
-                let f_n = self.friction_normal(self.layer_force(z)).max(0.0);
-                let next = stick_or_slip(self.stick_force(z).0, self.friction.mu_static() * f_n);
-                (next, friction_event(mode, next))
-            }
-            GuardKind::StickBreakPos => (Mode::SlipPos, Some(EventKind::Slip)),
-            GuardKind::StickBreakNeg => (Mode::SlipNeg, Some(EventKind::Slip)),
-            GuardKind::Separation => (Mode::Free, Some(EventKind::Separate)),
-            GuardKind::Contact => (self.friction_mode(z), Some(EventKind::Contact)),
+        if guard == GuardKind::SlipZero {
+            // On the surface v = 0 exactly.
+            z[UP] = self.p.V + z[UD];
         }
+        let z = &*z;
+        contact::after_guard(guard, mode, || {
+            if guard == GuardKind::SlipZero {
+                stick_or_slip(self.stick_force(z).0, self.stick_bound(z))
+            } else {
+                self.friction_mode(z)
+            }
+        })
     }
 
     fn initial_mode(&self, _t: f64, z: &[f64; 8]) -> Mode {

@@ -34,8 +34,8 @@
 //! `F_s = c1 ẋ + k11 x + k12 y`, satisfies `|F_s| ≤ μ_s·N`.
 
 use super::{
-    friction_event, stick_or_slip, EventKind, GuardKind, Guards, Mode, Model, ModelError,
-    Observables, Parameters,
+    contact, stick_or_slip, EventKind, GuardKind, Guards, Mode, Model, ModelError, Observables,
+    Parameters,
 };
 use crate::friction::FrictionLaw;
 use crate::params::{ParamError, ParamKind, ParamSpec};
@@ -178,15 +178,17 @@ impl Hoffmann {
 
     /// Friction mode for a state in contact, from the sign of v (stick test at v = 0).
     fn friction_mode(&self, z: &[f64; 4]) -> Mode {
-        let v = self.sliding_velocity(z);
-        if v > 0.0 {
-            Mode::SlipPos
-        } else if v < 0.0 {
-            Mode::SlipNeg
-        } else {
-            let n = self.normal_force(z).max(0.0);
-            stick_or_slip(self.stick_force(z), self.friction.mu_static() * n)
-        }
+        contact::friction_mode(
+            self.sliding_velocity(z),
+            self.stick_force(z),
+            self.stick_bound(z),
+        )
+    }
+
+    /// `μ_s·max(N, 0)`.
+    #[inline]
+    fn stick_bound(&self, z: &[f64; 4]) -> f64 {
+        self.friction.mu_static() * self.normal_force(z).max(0.0)
     }
 
     /// Stiffness matrix `K(μ) = [[k11, k12 − μ k3], [k12, k22]]` of the
@@ -300,29 +302,27 @@ impl Model<4> for Hoffmann {
             }
             return;
         }
+        // N = N0 + k3 y.
+        let normal = ([0.0, p.k3, 0.0, 0.0], p.N0);
         if self.contact_varies() {
             // Separation: −N crosses zero upwards.
-            out.push(GuardKind::Separation, [0.0, -p.k3, 0.0, 0.0], -p.N0);
+            let (c, d) = contact::separation_guard(&normal);
+            out.push(GuardKind::Separation, c, d);
         }
         match mode {
             Mode::SlipPos | Mode::SlipNeg => {
-                // g = −s·v = −s(V − ẋ).
-                let s = mode.slip_sign();
-                out.push(GuardKind::SlipZero, [0.0, 0.0, s, 0.0], -s * p.V);
+                // v = V − ẋ.
+                let (c, d) = contact::slip_zero_guard(mode, &([0.0, 0.0, -1.0, 0.0], p.V));
+                out.push(GuardKind::SlipZero, c, d);
             }
             Mode::Stick => {
-                // ±F_s − μ_s N, F_s = k11 x + k12 y + c1 ẋ, N = N0 + k3 y.
-                let mu_s = self.friction.mu_static();
-                out.push(
-                    GuardKind::StickBreakPos,
-                    [p.k11, p.k12 - mu_s * p.k3, p.c1, 0.0],
-                    -mu_s * p.N0,
-                );
-                out.push(
-                    GuardKind::StickBreakNeg,
-                    [-p.k11, -p.k12 - mu_s * p.k3, -p.c1, 0.0],
-                    -mu_s * p.N0,
-                );
+                // ±F_s − μ_s N, F_s = k11 x + k12 y + c1 ẋ.
+                let fs = ([p.k11, p.k12, p.c1, 0.0], 0.0);
+                for (kind, (c, d)) in
+                    contact::stick_break_guards(&fs, &normal, self.friction.mu_static())
+                {
+                    out.push(kind, c, d);
+                }
             }
             Mode::Free => unreachable!("handled above"),
         }
@@ -335,19 +335,18 @@ impl Model<4> for Hoffmann {
         guard: GuardKind,
         z: &mut [f64; 4],
     ) -> (Mode, Option<EventKind>) {
-        match guard {
-            GuardKind::SlipZero => {
-                // On the surface v = 0 exactly.
-                z[VX] = self.p.V;
-                let n = self.normal_force(z).max(0.0);
-                let next = stick_or_slip(self.stick_force(z), self.friction.mu_static() * n);
-                (next, friction_event(mode, next))
-            }
-            GuardKind::StickBreakPos => (Mode::SlipPos, Some(EventKind::Slip)),
-            GuardKind::StickBreakNeg => (Mode::SlipNeg, Some(EventKind::Slip)),
-            GuardKind::Separation => (Mode::Free, Some(EventKind::Separate)),
-            GuardKind::Contact => (self.friction_mode(z), Some(EventKind::Contact)),
+        if guard == GuardKind::SlipZero {
+            // On the surface v = 0 exactly.
+            z[VX] = self.p.V;
         }
+        let z = &*z;
+        contact::after_guard(guard, mode, || {
+            if guard == GuardKind::SlipZero {
+                stick_or_slip(self.stick_force(z), self.stick_bound(z))
+            } else {
+                self.friction_mode(z)
+            }
+        })
     }
 
     fn initial_mode(&self, _t: f64, z: &[f64; 4]) -> Mode {

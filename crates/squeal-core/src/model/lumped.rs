@@ -33,12 +33,13 @@
 //!
 //! State `z = (q, q̇)`; positions named after the dofs, velocities `v<dof>`.
 
-use super::contact::{Combination, Contact, Normal};
+use super::contact::{self, Combination, Contact, Normal};
 use super::{
     EventKind, Guard, GuardKind, Guards, Mode, ModelError, Modes, Observables, System, MAX_CONTACTS,
 };
 use crate::friction::FrictionLaw;
 use crate::params::ParamError;
+use crate::stability::projected::{ModalOptions, SecondOrder};
 use nalgebra::DMatrix;
 
 /// A bad model description: one line naming the element and key.
@@ -263,12 +264,17 @@ pub struct Lumped {
     m_matrix: Option<Sparse>,
     k_matrix: Option<Sparse>,
     c_matrix: Option<Sparse>,
-    /// Springs.
+    /// Springs. Change their parameters through [`Lumped::set`]: the
+    /// right-hand side of a small model uses operators derived from them.
     pub springs: Vec<Spring>,
-    /// Forces.
+    /// Forces (as [`Lumped::springs`]: change them through [`Lumped::set`]).
     pub forces: Vec<Force>,
-    /// Contacts.
+    /// Contacts (their combinations are derived into the right-hand side's
+    /// operators; laws, `V`, `alpha`, `k`, `c` are read directly).
     pub contacts: Vec<Contact>,
+    /// How the complex eigenvalue analysis is solved (dense or projected;
+    /// keys `modal.dense_max_dofs`, `modal.modes`, `modal.cutoff_hz`).
+    pub modal: ModalOptions,
     // Derived from the above by `refresh`.
     inv_mass: InvMass,
     /// `M⁻¹ t_j` per contact, dense.
@@ -278,6 +284,43 @@ pub struct Lumped {
     /// `t_i·M⁻¹ n_j`.
     tn: [[f64; MAX_CONTACTS]; MAX_CONTACTS],
     has_ramp: bool,
+    /// Dense operators of the right-hand side (models of at most
+    /// [`DENSE_FIELD_DOFS`] dofs); rebuilt whenever a parameter changes.
+    dense: Option<DenseField>,
+}
+
+/// Up to this many dofs the simulated right-hand side runs on operators
+/// folded once per parameter change (every spring, `K` and `C` in one list
+/// of non-zero entries, the constant forces in one vector) instead of
+/// looping over the elements.
+pub const DENSE_FIELD_DOFS: usize = 16;
+
+/// The right-hand side of a small model as folded sparse operators: every
+/// spring, `K` and `C` in one list of non-zero entries of the `n × 2n`
+/// matrix `∂force/∂z`, the constant forces in one vector, each contact's
+/// combinations as `(index, coefficient)` pairs on the state.
+#[derive(Debug, Clone, PartialEq, Default)]
+struct DenseField {
+    /// Number of dofs.
+    n: usize,
+    /// `(row, column on z, value)`: the force of springs, `K` and `C` is
+    /// `Σ value·z[column]` into `row` (duplicates summed at build).
+    kc: Vec<(usize, usize, f64)>,
+    /// `Σ value·on` of the forces without a ramp.
+    f0: Vec<f64>,
+    /// Per contact: `F_n` on `z` (`(k n, c n)`), the normal on the dofs,
+    /// the sliding velocity's `t` on `z` (velocities), the slope on `z`.
+    contacts: Vec<[Vec<(usize, f64)>; 4]>,
+}
+
+/// `Σ coef·z[index]`.
+#[inline(always)]
+fn dot_pairs(pairs: &[(usize, f64)], z: &[f64]) -> f64 {
+    let mut s = 0.0;
+    for &(i, c) in pairs {
+        s += c * z[i];
+    }
+    s
 }
 
 /// Up to this many dofs, guard evaluations use a stack buffer (no allocation).
@@ -455,9 +498,9 @@ impl Lumped {
                     "{kind} '{name}': name: not a valid element name (no '.', '=', ',' or spaces)"
                 ));
             }
-            if name == "mass" || names.iter().any(|x| x == name) {
+            if name == "mass" || name == "modal" || names.iter().any(|x| x == name) {
                 return bad(format!(
-                    "{kind} '{name}': name: already used (element names must be unique and not 'mass')"
+                    "{kind} '{name}': name: already used (element names must be unique and not 'mass' or 'modal')"
                 ));
             }
             names.push(name.to_string());
@@ -615,11 +658,13 @@ impl Lumped {
             springs,
             forces,
             contacts,
+            modal: ModalOptions::default(),
             inv_mass: InvMass::Diagonal(Vec::new()),
             minv_t: Vec::new(),
             gram: [[0.0; MAX_CONTACTS]; MAX_CONTACTS],
             tn: [[0.0; MAX_CONTACTS]; MAX_CONTACTS],
             has_ramp: false,
+            dense: None,
         };
         model.refresh()?;
         Ok(model)
@@ -722,7 +767,126 @@ impl Lumped {
                 }
             }
         }
+        self.rebuild_dense();
         Ok(())
+    }
+
+    /// Rebuild the dense operators of the right-hand side ([`DenseField`])
+    /// from the elements (small models only).
+    fn rebuild_dense(&mut self) {
+        let n = self.dofs.len();
+        if n > DENSE_FIELD_DOFS {
+            self.dense = None;
+            return;
+        }
+        let mut kc = vec![0.0; 2 * n * n];
+        for sp in &self.springs {
+            for (a, ca) in sp.on.idx.iter().zip(&sp.on.coef) {
+                for (b, cb) in sp.on.idx.iter().zip(&sp.on.coef) {
+                    kc[a * 2 * n + b] -= sp.k * ca * cb;
+                    kc[a * 2 * n + n + b] -= sp.c * ca * cb;
+                }
+            }
+        }
+        if let Some(k) = &self.k_matrix {
+            for (r, c, v) in k.entries() {
+                kc[r * 2 * n + c] -= v;
+            }
+        }
+        if let Some(cm) = &self.c_matrix {
+            for (r, c, v) in cm.entries() {
+                kc[r * 2 * n + n + c] -= v;
+            }
+        }
+        let mut f0 = vec![0.0; n];
+        for f in self.forces.iter().filter(|f| f.ramp <= 0.0) {
+            f.on.add_scaled(&mut f0, f.value);
+        }
+        let pairs = |v: &[f64]| -> Vec<(usize, f64)> {
+            v.iter()
+                .enumerate()
+                .filter(|(_, x)| **x != 0.0)
+                .map(|(i, x)| (i, *x))
+                .collect()
+        };
+        let contacts = self
+            .contacts
+            .iter()
+            .map(|c| {
+                let mut f_n = vec![0.0; 2 * n];
+                let mut nrm = vec![0.0; n];
+                if let Normal::Elastic {
+                    normal, k, c: cc, ..
+                } = &c.normal
+                {
+                    normal.add_scaled(&mut f_n[..n], *k);
+                    normal.add_scaled(&mut f_n[n..], *cc);
+                    normal.add_scaled(&mut nrm, 1.0);
+                }
+                let mut tan = vec![0.0; 2 * n];
+                c.tangent.add_scaled(&mut tan[n..], 1.0);
+                let mut slope = vec![0.0; 2 * n];
+                c.slope.add_scaled(&mut slope[..n], 1.0);
+                [pairs(&f_n), pairs(&nrm), pairs(&tan), pairs(&slope)]
+            })
+            .collect();
+        self.dense = Some(DenseField {
+            n,
+            kc: kc
+                .iter()
+                .enumerate()
+                .filter(|(_, x)| **x != 0.0)
+                .map(|(k, x)| (k / (2 * n), k % (2 * n), *x))
+                .collect(),
+            f0,
+            contacts,
+        });
+    }
+
+    /// The generalised force without stick multipliers on the folded
+    /// operators ([`DenseField`]) into `acc[..n]`: the same force as
+    /// [`Lumped::base_force`] (summed in another order).
+    #[inline(always)]
+    fn base_force_fixed(&self, d: &DenseField, t: f64, modes: &Modes, z: &[f64], acc: &mut [f64]) {
+        acc.copy_from_slice(&d.f0);
+        if self.has_ramp {
+            for f in self.forces.iter().filter(|f| f.ramp > 0.0) {
+                f.on.add_scaled(acc, f.value * f.factor(t));
+            }
+        }
+        for &(r, c, v) in &d.kc {
+            acc[r] += v * z[c];
+        }
+        for ((i, c), [f_n_on, nrm, tan, slope]) in self.contacts.iter().enumerate().zip(&d.contacts)
+        {
+            let mode = modes.get(i);
+            if mode == Mode::Free {
+                continue;
+            }
+            let f_n = match &c.normal {
+                Normal::Elastic { .. } => {
+                    let f_n = dot_pairs(f_n_on, z);
+                    for &(j, x) in nrm {
+                        acc[j] -= f_n * x;
+                    }
+                    f_n
+                }
+                Normal::Prescribed(f) => *f,
+            };
+            if mode != Mode::Stick {
+                let f_t = c.slip_force(mode, c.v + dot_pairs(tan, z), f_n);
+                let n = d.n;
+                for &(j, x) in tan {
+                    acc[j - n] -= f_t * x;
+                }
+                if c.alpha != 0.0 && matches!(c.normal, Normal::Elastic { .. }) {
+                    let f_f = c.alpha * f_t * dot_pairs(slope, z);
+                    for &(j, x) in nrm {
+                        acc[j] += f_f * x;
+                    }
+                }
+            }
+        }
     }
 
     /// `M⁻¹ x` (allocating; for set-up).
@@ -871,6 +1035,13 @@ impl Lumped {
         acc: &mut [f64],
     ) -> [f64; MAX_CONTACTS] {
         self.base_force(t, modes, q, u, acc, true);
+        self.add_stick_forces(modes, q, acc)
+    }
+
+    /// Add the sticking contacts' forces (the multipliers for the force
+    /// `acc` without them) to `acc`; the multipliers indexed by contact.
+    #[inline]
+    fn add_stick_forces(&self, modes: &Modes, q: &[f64], acc: &mut [f64]) -> [f64; MAX_CONTACTS] {
         let (set, k) = stick_set(modes);
         let mut out = [0.0; MAX_CONTACTS];
         if k > 0 {
@@ -1203,6 +1374,42 @@ impl Lumped {
         }
     }
 
+    /// The linearised second-order system `M q̈ + C q̇ + K q = 0` of the
+    /// sliding equations at `z` (the same linearisation as
+    /// [`Lumped::jacobian_dyn`], `M` with the `[masses]` added, `K`, `C` the
+    /// negated force Jacobian, non-symmetric where friction acts).
+    pub fn second_order_dyn(&self, z: &[f64]) -> SecondOrder {
+        let n = self.dofs.len();
+        let modes = self.sliding_modes_at(z);
+        let jf = self.force_jacobian(&modes, z);
+        let mut m = DMatrix::<f64>::zeros(n, n);
+        if let Some(mm) = &self.m_matrix {
+            for (r, c, v) in mm.entries() {
+                m[(r, c)] += v;
+            }
+        }
+        for i in 0..n {
+            m[(i, i)] += self.masses[i];
+        }
+        SecondOrder {
+            m,
+            k: -jf.columns(0, n),
+            c: -jf.columns(n, n),
+        }
+    }
+
+    /// The analysis options' keys (`modal.dense_max_dofs`, `modal.modes`,
+    /// `modal.cutoff_hz`); not in [`Lumped::keys`] (they are not physical
+    /// parameters to sweep).
+    fn modal_get(&self, key: &str) -> Option<f64> {
+        match key {
+            "modal.dense_max_dofs" => Some(self.modal.dense_max_dofs as f64),
+            "modal.modes" => Some(self.modal.modes as f64),
+            "modal.cutoff_hz" => Some(self.modal.cutoff_hz),
+            _ => None,
+        }
+    }
+
     // ---- Parameters: `<element>.<key>` and `mass.<dof>` ----
 
     /// Every parameter key with its current value, in file order.
@@ -1243,6 +1450,9 @@ impl Lumped {
 
     /// Value of a parameter by key.
     pub fn get(&self, key: &str) -> Option<f64> {
+        if let Some(v) = self.modal_get(key) {
+            return Some(v);
+        }
         self.keys()
             .into_iter()
             .find(|(k, _)| k == key)
@@ -1251,7 +1461,9 @@ impl Lumped {
 
     /// Set a parameter by key, checking its range; the model is re-checked
     /// (stick constraints, mass matrix) afterwards. Keys are
-    /// `<element>.<key>` and `mass.<dof>`.
+    /// `<element>.<key>`, `mass.<dof>` and the analysis options
+    /// `modal.dense_max_dofs`, `modal.modes`, `modal.cutoff_hz`
+    /// ([`ModalOptions`]).
     pub fn set(&mut self, key: &str, value: f64) -> Result<(), ParamError> {
         let invalid = |why: &str| ParamError::Invalid {
             key: key.into(),
@@ -1310,6 +1522,25 @@ impl Lumped {
                 }
                 _ => return Err(unknown()),
             }
+        } else if el == "modal" {
+            let count = |v: f64| {
+                if v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v <= 1e9 {
+                    Ok(v as usize)
+                } else {
+                    Err(invalid("must be a whole number ≥ 0"))
+                }
+            };
+            match k {
+                "dense_max_dofs" => self.modal.dense_max_dofs = count(value)?,
+                "modes" => self.modal.modes = count(value)?,
+                "cutoff_hz" => {
+                    if !(value.is_finite() && value > 0.0) {
+                        return Err(invalid("must be a finite frequency > 0 (Hz)"));
+                    }
+                    self.modal.cutoff_hz = value;
+                }
+                _ => return Err(unknown()),
+            }
         } else {
             return Err(unknown());
         }
@@ -1320,6 +1551,7 @@ impl Lumped {
                 why: e.0,
             })?;
         }
+        self.rebuild_dense();
         Ok(())
     }
 
@@ -1336,6 +1568,13 @@ impl Lumped {
         let (el, k) = key.split_once('.')?;
         if el == "mass" {
             return Some(("kg", format!("mass of dof {k}")));
+        }
+        if el == "modal" && self.modal_get(key).is_some() {
+            return Some(match k {
+                "dense_max_dofs" => ("", "largest model (dofs) solved by the dense eigen-analysis; larger ones by projection onto undamped modes".to_string()),
+                "modes" => ("", "number of undamped modes of the projection basis (0: by modal.cutoff_hz)".to_string()),
+                _ => ("Hz", "highest undamped frequency of the projection basis".to_string()),
+            });
         }
         if self.springs.iter().any(|s| s.name == el) {
             return match k {
@@ -1373,6 +1612,13 @@ impl Lumped {
         let (el, k) = key.split_once('.').unwrap_or(("", key));
         if el == "mass" {
             return ParamKind::Positive;
+        }
+        if el == "modal" {
+            return if k == "cutoff_hz" {
+                ParamKind::Positive
+            } else {
+                ParamKind::NonNegative
+            };
         }
         match k {
             "value" | "V" | "alpha" => ParamKind::Any,
@@ -1426,7 +1672,17 @@ impl<const N: usize> System<N> for Lumped {
         let n = N / 2;
         let (q, u) = z.split_at(n);
         let mut acc = [0.0; N];
-        self.force(t, modes, q, u, &mut acc[..n]);
+        match &self.dense {
+            Some(d) => {
+                self.base_force_fixed(d, t, modes, z, &mut acc[..n]);
+                if modes.as_slice().contains(&Mode::Stick) {
+                    self.add_stick_forces(modes, q, &mut acc[..n]);
+                }
+            }
+            _ => {
+                self.force(t, modes, q, u, &mut acc[..n]);
+            }
+        }
         dz[..n].copy_from_slice(u);
         self.apply_inv_mass(&acc[..n], &mut dz[n..]);
     }
@@ -1460,18 +1716,21 @@ impl<const N: usize> System<N> for Lumped {
                     normal, k, c: cc, ..
                 } = &c.normal
                 {
-                    let mut g = [0.0; N];
-                    normal.add_scaled(&mut g[..n], -k);
-                    normal.add_scaled(&mut g[n..], -cc);
-                    push(GuardKind::Separation, g, 0.0, true);
+                    // F_n = k δ + c δ̇.
+                    let mut f_n = [0.0; N];
+                    normal.add_scaled(&mut f_n[..n], *k);
+                    normal.add_scaled(&mut f_n[n..], *cc);
+                    let (g, d) = contact::separation_guard(&(f_n, 0.0));
+                    push(GuardKind::Separation, g, d, true);
                 }
             }
             match mode {
                 Mode::SlipPos | Mode::SlipNeg => {
-                    let s = mode.slip_sign();
-                    let mut g = [0.0; N];
-                    c.tangent.add_scaled(&mut g[n..], -s);
-                    push(GuardKind::SlipZero, g, -s * c.v, true);
+                    // v = V + t·q̇.
+                    let mut v = [0.0; N];
+                    c.tangent.add_scaled(&mut v[n..], 1.0);
+                    let (g, d) = contact::slip_zero_guard(mode, &(v, c.v));
+                    push(GuardKind::SlipZero, g, d, true);
                 }
                 Mode::Stick => {
                     for (kind, sign) in [
@@ -1618,50 +1877,42 @@ impl<const N: usize> System<N> for Lumped {
         let i = g.contact as usize;
         let old = modes.get(i);
         let mut next = *modes;
-        match g.kind {
-            GuardKind::SlipZero => {
-                // On the surface v = 0 exactly: the mass-weighted projection
-                // u ← u − v·M⁻¹t/(t·M⁻¹t).
-                let c = &self.contacts[i];
-                let v = c.sliding_velocity(&z[n..]);
-                let w = v / self.gram[i][i];
-                for k in 0..n {
-                    z[n + k] -= w * self.minv_t[i][k];
-                }
-                let m = self.contact_mode(t, &next, i, &z[..]);
-                // Reached v = 0 without leaving the contact: stick or slip on.
-                let m = if m == Mode::Free { old } else { m };
-                next.set(i, m);
-                (next, Contact::event(old, m))
-            }
-            GuardKind::StickBreakPos => {
-                next.set(i, Mode::SlipPos);
-                (next, Some(EventKind::Slip))
-            }
-            GuardKind::StickBreakNeg => {
-                next.set(i, Mode::SlipNeg);
-                (next, Some(EventKind::Slip))
-            }
-            GuardKind::Separation => {
-                next.set(i, Mode::Free);
-                (next, Some(EventKind::Separate))
-            }
-            GuardKind::Contact => {
-                // On the surface δ = 0: decide the friction mode as in contact.
-                let c = &self.contacts[i];
-                let f_n = c.normal_force(&z[..n], &z[n..]);
-                let v = c.sliding_velocity(&z[n..]);
-                let m = if v != 0.0 {
-                    c.mode_for(v, 0.0, f_n)
-                } else {
-                    let mut trial = next;
-                    trial.set(i, Mode::Stick);
-                    c.mode_for(0.0, self.stick_force(t, &trial, i, &z[..]), f_n)
-                };
-                next.set(i, m);
-                (next, Some(EventKind::Contact))
+        let c = &self.contacts[i];
+        if g.kind == GuardKind::SlipZero {
+            // On the surface v = 0 exactly: the mass-weighted projection
+            // u ← u − v·M⁻¹t/(t·M⁻¹t).
+            let v = c.sliding_velocity(&z[n..]);
+            let w = v / self.gram[i][i];
+            for k in 0..n {
+                z[n + k] -= w * self.minv_t[i][k];
             }
         }
+        let z = &*z;
+        let (m, event) = contact::after_guard(g.kind, old, || {
+            if g.kind == GuardKind::SlipZero {
+                let m = self.contact_mode(t, modes, i, &z[..]);
+                // Reached v = 0 without leaving the contact: stick or slip on.
+                if m == Mode::Free {
+                    old
+                } else {
+                    m
+                }
+            } else {
+                // On the surface δ = 0: decide the friction mode as in contact.
+                let f_n = c.normal_force(&z[..n], &z[n..]);
+                let v = c.sliding_velocity(&z[n..]);
+                let f_stick = if v != 0.0 {
+                    0.0
+                } else {
+                    let mut trial = *modes;
+                    trial.set(i, Mode::Stick);
+                    self.stick_force(t, &trial, i, &z[..])
+                };
+                c.mode_for(v, f_stick, f_n)
+            }
+        });
+        next.set(i, m);
+        (next, event)
     }
 
     fn start_modes(&self, t: f64, z: &[f64; N]) -> Modes {

@@ -358,9 +358,13 @@ pub fn newton_equilibrium<M: Model<N> + ?Sized, const N: usize>(
     Ok(z)
 }
 
+/// Up to this many positions [`newton_positions`] solves with nalgebra's LU;
+/// above, with faer's blocked LU.
+const NEWTON_SMALL: usize = 64;
+
 /// Newton's method on positions `q` for `r(q) = 0`: `eval(q)` gives the
 /// Newton matrix `∂r/∂q` and the residual `r`; each iteration solves by LU
-/// with partial pivoting. Converges when the update is below 1e-14 of the
+/// with partial pivoting (nalgebra up to 64 positions, faer above). Converges when the update is below 1e-14 of the
 /// positions' size (at most 100 iterations); a singular matrix is
 /// [`ModelError::NoSteadySliding`] with the message `singular`. Shared by
 /// [`newton_equilibrium`] and the lumped models' runtime-size equilibrium.
@@ -371,10 +375,23 @@ where
     let mut q = q0.to_vec();
     for _ in 0..100 {
         let (a, r) = eval(&q);
-        let dq = a
-            .lu()
-            .solve(&(-r))
-            .ok_or_else(|| ModelError::NoSteadySliding(singular.into()))?;
+        let dq = if a.nrows() <= NEWTON_SMALL {
+            a.lu()
+                .solve(&(-r))
+                .ok_or_else(|| ModelError::NoSteadySliding(singular.into()))?
+        } else {
+            // faer's blocked LU: nalgebra's unblocked one takes seconds at 2000 dofs.
+            use faer::linalg::solvers::Solve;
+            let n = a.nrows();
+            let lu =
+                faer::MatRef::from_column_major_slice(a.as_slice(), n, a.ncols()).partial_piv_lu();
+            let x = lu.solve(faer::Mat::<f64>::from_fn(n, 1, |i, _| -r[i]));
+            let dq = nalgebra::DVector::from_fn(n, |i, _| x[(i, 0)]);
+            if dq.iter().any(|d| !d.is_finite()) {
+                return Err(ModelError::NoSteadySliding(singular.into()));
+            }
+            dq
+        };
         let size = q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let step = dq.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         for (qi, d) in q.iter_mut().zip(dq.iter()) {

@@ -1,21 +1,22 @@
 //! Stability of lumped models of any size: the steady-sliding state by
-//! Newton's method, the analytic state matrix (dense, `2n × 2n`), and the
-//! size-independent complex eigen-analysis of [`super::modal`]. Models small
-//! enough for the fixed-size path ([`crate::model::lumped::MAX_SIM_DOFS`]
-//! dofs) go through [`super::analyse`] instead (the same eigenvalues).
+//! Newton's method, the analytic linearisation, and the size-independent
+//! complex eigen-analysis: dense ([`super::modal`]: every eigenvalue of the
+//! `2n × 2n` state matrix) up to [`ModalOptions::dense_max_dofs`] dofs, by
+//! projection onto the lowest undamped modes above ([`super::projected`]).
+//! Models small enough for the fixed-size path
+//! ([`crate::model::lumped::MAX_SIM_DOFS`] dofs) go through
+//! [`super::analyse`] instead (the same eigenvalues).
+//!
+//! [`ModalOptions::dense_max_dofs`]: super::projected::ModalOptions::dense_max_dofs
 
+use super::projected::{self, Method};
 use super::{Analysis, StabilityError};
 use crate::model::lumped::Lumped;
 use nalgebra::DMatrix;
 
 /// The steady-sliding state and the state matrix there, both checked finite.
 pub fn state_matrix(l: &Lumped) -> Result<(Vec<f64>, DMatrix<f64>), StabilityError> {
-    let z = l.equilibrium_dyn()?;
-    if z.iter().any(|x| !x.is_finite()) {
-        return Err(StabilityError::NonFinite {
-            what: "equilibrium",
-        });
-    }
+    let z = equilibrium(l)?;
     let a = l.jacobian_dyn(&z);
     if a.iter().any(|x| !x.is_finite()) {
         return Err(StabilityError::NonFinite { what: "Jacobian" });
@@ -23,11 +24,37 @@ pub fn state_matrix(l: &Lumped) -> Result<(Vec<f64>, DMatrix<f64>), StabilityErr
     Ok((z, a))
 }
 
-/// All eigenvalues of the state matrix ([`super::modal::eigenvalues`]: the
-/// balanced hand-written QR up to 64 states, faer above).
+/// The steady-sliding state, checked finite.
+fn equilibrium(l: &Lumped) -> Result<Vec<f64>, StabilityError> {
+    let z = l.equilibrium_dyn()?;
+    if z.iter().any(|x| !x.is_finite()) {
+        return Err(StabilityError::NonFinite {
+            what: "equilibrium",
+        });
+    }
+    Ok(z)
+}
+
+/// The eigenvalues of steady sliding and how they were computed: every
+/// eigenvalue of the state matrix ([`super::modal::eigenvalues`]: the
+/// balanced hand-written QR up to 64 states, faer above) for a model of at
+/// most `l.modal.dense_max_dofs` dofs, else the `2m` eigenvalues of the
+/// projection onto `m` undamped modes ([`projected::projected_eigenvalues`]).
+pub fn eigenvalues_with_method(
+    l: &Lumped,
+) -> Result<(Vec<nalgebra::Complex<f64>>, Method), StabilityError> {
+    if l.modal.projects(l.dof_count()) {
+        let z = equilibrium(l)?;
+        projected::projected_eigenvalues(&l.second_order_dyn(&z), l.modal.basis())
+    } else {
+        let (_, a) = state_matrix(l)?;
+        Ok((super::modal::eigenvalues(&a)?, Method::Dense))
+    }
+}
+
+/// The eigenvalues of steady sliding ([`eigenvalues_with_method`]).
 pub fn eigenvalues(l: &Lumped) -> Result<Vec<nalgebra::Complex<f64>>, StabilityError> {
-    let (_, a) = state_matrix(l)?;
-    super::modal::eigenvalues(&a)
+    eigenvalues_with_method(l).map(|(ev, _)| ev)
 }
 
 /// Largest growth rate and its frequency (Hz), for maps and `critical`.
@@ -43,9 +70,22 @@ pub fn max_growth_rate(l: &Lumped) -> Result<(f64, f64), StabilityError> {
 }
 
 /// Full complex eigenvalue analysis of a lumped model of any size (every
-/// mode with its eigenvector, energy shares and dominant coordinate), by
-/// [`super::modal::analyse_matrix`].
+/// mode with its eigenvector, energy shares and dominant coordinate): dense
+/// by [`super::modal::analyse_matrix`] up to `l.modal.dense_max_dofs` dofs,
+/// above by [`projected::analyse_projected`] ([`Analysis::method`] says which,
+/// and with how many modes).
 pub fn analyse(l: &Lumped, masses: Option<&[f64]>) -> Result<Analysis, StabilityError> {
-    let (z, a) = state_matrix(l)?;
-    super::modal::analyse_matrix(&a, &z, l.state_names(), masses)
+    if l.modal.projects(l.dof_count()) {
+        let z = equilibrium(l)?;
+        projected::analyse_projected(
+            &l.second_order_dyn(&z),
+            &z,
+            l.state_names(),
+            masses,
+            l.modal.basis(),
+        )
+    } else {
+        let (z, a) = state_matrix(l)?;
+        super::modal::analyse_matrix(&a, &z, l.state_names(), masses)
+    }
 }

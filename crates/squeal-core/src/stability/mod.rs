@@ -27,6 +27,9 @@
 //! - [`modal::analyse_matrix`]: the same analysis for a state matrix of any
 //!   size known at run time (faer for thousands of states), and complex mode
 //!   shapes ([`modal::mode_shape`]);
+//! - [`projected::analyse_projected`]: the complex eigenvalue analysis of
+//!   large models by projection onto their lowest undamped modes (as FE
+//!   packages do);
 //! - [`sweep::sweep`]: every eigenvalue along a one-parameter sweep, tracked
 //!   continuously (MAC + Hungarian assignment), with located onsets and
 //!   coalescences (the mode-coupling diagram);
@@ -40,6 +43,7 @@
 pub mod eigen;
 pub mod lumped;
 pub mod modal;
+pub mod projected;
 pub mod sweep;
 pub mod track;
 
@@ -183,6 +187,10 @@ pub struct Analysis {
     pub least_stable: usize,
     /// The steady-sliding state `z*`.
     pub equilibrium: Vec<f64>,
+    /// How the eigenvalues were computed: every one of the full state matrix
+    /// ([`projected::Method::Dense`]), or by projection onto undamped modes
+    /// ([`projected::Method::Projected`], a reduced-basis answer).
+    pub method: projected::Method,
 }
 
 impl Analysis {

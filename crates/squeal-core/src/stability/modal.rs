@@ -313,6 +313,7 @@ pub(crate) fn finish(mut modes: Vec<Eigen>, equilibrium: Vec<f64>) -> Analysis {
         least_stable: 0,
         equilibrium,
         eigen: modes,
+        method: super::projected::Method::Dense,
     }
 }
 

@@ -62,13 +62,14 @@ pub fn run(a: CriticalArgs) -> Result<(), RunError> {
     }
     let found = locate(&sc.model, &name, lo, hi, a.grid, &crate::run::NEVER)?;
     if a.json {
-        let doc = match &found {
+        let mut doc = match &found {
             Some(c) => json!({
                 "param": name, "value": c.value, "freq_hz": c.freq_hz,
                 "direction": c.direction, "from_neutral": c.from_neutral,
             }),
             None => json!({ "param": name, "value": null, "freq_hz": null }),
         };
+        doc["modal"] = squeal_study::stability::modal_options_json(&sc.model);
         crate::outln!(
             "{}",
             serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?

@@ -61,6 +61,20 @@ pub fn write_modes_csv(
     w.flush().map_err(io)
 }
 
+/// One line saying that the analysis is a reduced-basis one, if it is.
+fn modal_line(an: &Analysis) -> Option<String> {
+    match an.method {
+        squeal_core::stability::projected::Method::Dense => None,
+        squeal_core::stability::projected::Method::Projected {
+            modes,
+            dofs,
+            basis_max_hz,
+        } => Some(format!(
+            "projected onto the {modes} lowest undamped modes of {dofs} dofs (up to {basis_max_hz:.1} Hz): a reduced-basis answer for the modes in that band, none above it (modal.modes / modal.cutoff_hz / modal.dense_max_dofs choose)"
+        )),
+    }
+}
+
 /// Run the command.
 pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
@@ -98,6 +112,9 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         sc.model.name(),
         an.max_growth_rate
     );
+    if let Some(line) = modal_line(&an) {
+        crate::outln!("{line}");
+    }
     crate::outln!(
         "{:>3}  {:>15}  {:>15}  {:>12}  {:>14}  dominant",
         "#",
