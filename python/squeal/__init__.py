@@ -301,16 +301,14 @@ def critical(
     """Where steady sliding changes stability (``squeal critical``):
     ``{"param", "value", "freq_hz"}`` (plus ``direction`` and
     ``from_neutral`` when found; ``value`` and ``freq_hz`` None when nothing
-    crosses in the interval)."""
+    crosses in the interval; ``modal``: how the eigenvalues are computed) —
+    the document of ``squeal critical --json``."""
     try:
         name, lo, hi = param
         lo, hi = float(lo), float(hi)
     except (TypeError, ValueError):
         raise ScenarioError(f"param {param!r}: expected (NAME, LO, HI)") from None
-    found = _squeal.critical(*_source(scenario), _sets(set, params), str(name), lo, hi, int(grid))
-    if found is None:
-        return {"param": str(name), "value": None, "freq_hz": None}
-    return json.loads(found)
+    return json.loads(_squeal.critical(*_source(scenario), _sets(set, params), str(name), lo, hi, int(grid)))
 
 
 def sweep(

@@ -433,13 +433,15 @@ fn critical(
     let found = compute(py, |cancel| {
         squeal_study::critical::locate(&sc.model, &name, lo, hi, grid, cancel)
     })?;
-    match found {
-        None => Ok(None),
-        Some(c) => Ok(Some(json_text(&serde_json::json!({
+    let mut doc = match found {
+        None => serde_json::json!({ "param": name, "value": null, "freq_hz": null }),
+        Some(c) => serde_json::json!({
             "param": name, "value": c.value, "freq_hz": c.freq_hz,
             "direction": c.direction, "from_neutral": c.from_neutral,
-        }))?)),
-    }
+        }),
+    };
+    doc["modal"] = squeal_study::stability::modal_options_json(&sc.model);
+    Ok(Some(json_text(&doc)?))
 }
 
 /// An eigenvalue sweep: values, the eigenvalues (values × branches) and the
