@@ -32,6 +32,17 @@ pub struct Axis {
     pub log: bool,
 }
 
+/// The two axes of a map must vary different parameters.
+pub fn check_distinct(x: &Axis, y: &Axis) -> Result<(), InputError> {
+    if x.name == y.name {
+        return Err(InputError(format!(
+            "--x and --y both vary {}: choose two parameters",
+            x.name
+        )));
+    }
+    Ok(())
+}
+
 /// Parse `NAME=LO:HI:N` into grid values.
 pub fn parse_axis(spec: &str, flag: &str, log: bool, model: &AnyModel) -> Result<Axis, InputError> {
     let bad = |why: &str| InputError(format!("{flag} {spec}: {why}"));

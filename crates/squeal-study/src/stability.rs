@@ -60,6 +60,35 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
     })
 }
 
+/// Whether [`levers`] are searched for this model: they need hundreds of
+/// analyses, so only models of the fixed-size path (every built-in, lumped
+/// models up to `MAX_SIM_DOFS` dofs) get them.
+pub fn searches_levers(model: &AnyModel) -> bool {
+    !matches!(model, AnyModel::Lumped(l)
+        if l.dof_count() > squeal_core::model::lumped::MAX_SIM_DOFS)
+}
+
+/// The levers of `model` when [`searches_levers`] says so, none otherwise.
+pub fn levers_if_searched(model: &AnyModel) -> Vec<Lever> {
+    if searches_levers(model) {
+        levers(model)
+    } else {
+        Vec::new()
+    }
+}
+
+/// The whole document of `squeal stability --json` (and of Python's
+/// `Stability.to_dict()`): [`analysis_json`] plus the scenario and the levers.
+pub fn document(sc: &crate::Scenario, an: &Analysis, levers: &[Lever]) -> Value {
+    let mut doc = analysis_json(&sc.model, an);
+    doc["scenario"] = sc.to_json();
+    doc["levers"] = json!(levers
+        .iter()
+        .map(|l| json!({ "param": l.param, "from": l.from, "to": l.to, "freq_hz": l.freq_hz }))
+        .collect::<Vec<_>>());
+    doc
+}
+
 /// How a study of `model` (a critical value, a map: one eigen-analysis per
 /// point) computes its eigenvalues: `{"method": "dense"}`, or for a lumped
 /// model above `modal.dense_max_dofs` `{"method": "projected",

@@ -10,10 +10,9 @@ use clap::Args;
 use serde_json::json;
 use squeal_plot::{Colormap, Format, HeatmapSpec};
 use squeal_study::map::{
-    agree, all_points, linear_grid, parse_axis, point, transient_grid, unit_of, Axis, Outcome,
-    CLASSES,
+    agree, all_points, check_distinct, linear_grid, parse_axis, point, transient_grid, unit_of,
+    Axis, Outcome, CLASSES,
 };
-use squeal_study::scenario::InputError;
 use squeal_study::Scenario;
 use std::io::Write;
 use std::path::PathBuf;
@@ -279,13 +278,7 @@ pub fn prepare(a: &MapArgs) -> Result<(Scenario, Axis, Axis), RunError> {
     };
     let x = parse_axis(&a.x, "--x", a.log_x, &sc.model)?;
     let y = parse_axis(&a.y, "--y", a.log_y, &sc.model)?;
-    if x.name == y.name {
-        return Err(InputError(format!(
-            "--x and --y both vary {}: choose two parameters",
-            x.name
-        ))
-        .into());
-    }
+    check_distinct(&x, &y)?;
     Ok((sc, x, y))
 }
 

@@ -8,10 +8,9 @@ use crate::commands::simulate::resolve;
 use crate::run::RunError;
 use crate::ScenarioArgs;
 use clap::Args;
-use serde_json::json;
 use squeal_core::stability::Analysis;
 use squeal_study::model::AnyModel;
-use squeal_study::stability::{analyse, analysis_json, levers, shape_of};
+use squeal_study::stability::{analyse, document, levers_if_searched, searches_levers, shape_of};
 
 /// Arguments of `squeal stability`.
 #[derive(Args, Debug)]
@@ -90,16 +89,10 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         stage.commit()?;
     }
     // Levers need hundreds of analyses: only for models of the fixed-size path.
-    let large = matches!(&sc.model, AnyModel::Lumped(l)
-        if l.dof_count() > squeal_core::model::lumped::MAX_SIM_DOFS);
-    let levers = if large { Vec::new() } else { levers(&sc.model) };
+    let large = !searches_levers(&sc.model);
+    let levers = levers_if_searched(&sc.model);
     if a.json {
-        let mut doc = analysis_json(&sc.model, &an);
-        doc["scenario"] = sc.to_json();
-        doc["levers"] = json!(levers
-            .iter()
-            .map(|l| json!({ "param": l.param, "from": l.from, "to": l.to, "freq_hz": l.freq_hz }))
-            .collect::<Vec<_>>());
+        let doc = document(&sc, &an, &levers);
         crate::outln!(
             "{}",
             serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?

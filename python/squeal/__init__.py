@@ -1,0 +1,334 @@
+"""squeal: friction-induced vibration (disc-brake squeal) from Python.
+
+NumPy in, NumPy out, over exactly the engine the ``squeal`` command line
+uses (the library crate ``squeal-study``): the same input gives the same bits.
+
+    >>> import squeal
+    >>> run = squeal.simulate("disc-pad", duration=0.2, N=2000)
+    >>> run["vx_p"], run.summary["verdict"]
+    >>> st = squeal.stability("disc-pad", V=2.0)
+    >>> st.growth_rates.max(), st.least_stable
+    >>> ds = squeal.map("disc-pad", x=("V", 0.5, 20, 40), y=("N", 100, 3000, 30))
+
+``scenario`` is a built-in name (``squeal.scenarios()``), a path to a TOML
+file, or a dict with the TOML's structure (``squeal.scenario(name)`` gives
+one to edit). Keyword parameters are the CLI's ``--set`` keys (``N=2000``);
+``set={"pad1.V": 2.0}`` takes keys that are not Python identifiers.
+
+Every computation releases the GIL and can be interrupted with Ctrl-C
+(``KeyboardInterrupt``). Bad input raises :class:`ScenarioError` (a
+``ValueError``) with the CLI's one-line message naming the key; numerical
+failures raise :class:`SquealError` (a ``RuntimeError``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from squeal import _squeal
+from squeal._squeal import ScenarioError, SquealError
+
+__all__ = [
+    "Run",
+    "ScenarioError",
+    "SquealError",
+    "Stability",
+    "branch",
+    "critical",
+    "cycle",
+    "map",
+    "scenario",
+    "scenarios",
+    "simulate",
+    "stability",
+    "sweep",
+]
+
+Scenario = Union[str, "os.PathLike[str]", Mapping[str, Any]]
+Axis = Tuple[str, float, float, int]
+
+
+def _source(scenario: Scenario) -> Tuple[str, str]:
+    """The (kind, text) pair the compiled module resolves a scenario from."""
+    if isinstance(scenario, Mapping):
+        try:
+            return "json", json.dumps(scenario, allow_nan=True, default=_plain)
+        except TypeError as e:
+            raise ScenarioError(f"scenario dict: {e}") from None
+    if isinstance(scenario, (str, os.PathLike)):
+        return "spec", os.fspath(scenario)
+    raise ScenarioError(
+        f"scenario {scenario!r}: expected a built-in name, a path to a TOML file or a dict"
+    )
+
+
+def _plain(v: Any) -> Any:
+    """NumPy scalars and arrays inside a scenario dict, as plain Python."""
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    raise TypeError(f"{v!r} ({type(v).__name__}) has no TOML form")
+
+
+def _value(v: Any) -> str:
+    """A --set value as the command line would spell it (floats round-trip)."""
+    if isinstance(v, (bool, np.bool_)):
+        return "true" if v else "false"
+    if isinstance(v, np.generic):
+        v = v.item()
+    if isinstance(v, float):
+        return repr(v)
+    return str(v)
+
+
+def _sets(set: Optional[Mapping[str, Any]], params: Mapping[str, Any]) -> List[str]:
+    """`--set KEY=VALUE` strings from the `set` dict, then the keyword params."""
+    out = []
+    for d in (set or {}), params:
+        for k, v in d.items():
+            out.append(f"{k}={_value(v)}")
+    return out
+
+
+def scenarios() -> List[str]:
+    """The built-in scenario names (as ``squeal scenario list`` gives them)."""
+    return list(_squeal.scenarios())
+
+
+def scenario(name: Scenario = "disc-pad", *, set=None, **params) -> Dict[str, Any]:
+    """A scenario as a dict with the structure of its TOML file (``squeal
+    scenario show``), with overrides applied; edit it and pass it back as the
+    ``scenario`` of any function."""
+    _, doc = _squeal.scenario_doc(*_source(name), _sets(set, params))
+    return json.loads(doc)
+
+
+class Run:
+    """A simulated run.
+
+    ``t`` (float64), ``columns`` (names), ``data`` (samples × columns,
+    float64; each column contiguous), ``run["vx_p"]`` (one column, a view),
+    ``events`` (dict of arrays ``t``, ``kind``, ``contact``), ``summary`` (the
+    dict ``summary.json`` holds: verdict, squeal answer, spectra peaks, …),
+    ``spectra`` (``{signal: (freq_hz, psd)}``, the Welch spectra behind the
+    summary), ``sample_rate`` (Hz).
+    """
+
+    def __init__(self, raw: Dict[str, Any]):
+        self.columns: List[str] = list(raw["columns"])
+        self.data: np.ndarray = raw["data"]
+        self.events: Dict[str, np.ndarray] = {
+            "t": raw["event_t"],
+            "kind": np.array(raw["event_kind"], dtype=str),
+            "contact": np.array(raw["event_contact"], dtype=str),
+        }
+        self.summary: Dict[str, Any] = json.loads(raw["summary"])
+        self.spectra: Dict[str, Tuple[np.ndarray, np.ndarray]] = dict(raw["spectra"])
+        self.sample_rate: float = raw["sample_rate"]
+        self._index = {c: i for i, c in enumerate(self.columns)}
+
+    @property
+    def t(self) -> np.ndarray:
+        """Sample times (s)."""
+        return self.data[:, 0]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        try:
+            return self.data[:, self._index[name]]
+        except KeyError:
+            raise KeyError(f"{name}: no such column; columns are {', '.join(self.columns)}") from None
+
+    def __len__(self) -> int:
+        return self.data.shape[0]
+
+    def __repr__(self) -> str:
+        return (
+            f"<squeal.Run {self.summary.get('scenario', {}).get('name', '?')}: "
+            f"{self.data.shape[0]} samples × {self.data.shape[1]} columns, "
+            f"verdict {self.summary.get('verdict', '?')}>"
+        )
+
+    def to_pandas(self):
+        """The series as a ``pandas.DataFrame`` indexed by ``t`` (needs pandas)."""
+        import pandas as pd
+
+        return pd.DataFrame(self.data[:, 1:], index=pd.Index(self.t, name="t"), columns=self.columns[1:])
+
+    def to_xarray(self):
+        """The series as an ``xarray.Dataset`` over ``t`` (needs xarray)."""
+        import xarray as xr
+
+        return xr.Dataset(
+            {c: ("t", self.data[:, i]) for i, c in enumerate(self.columns) if i > 0},
+            coords={"t": self.t},
+            attrs={"scenario": self.summary.get("scenario", {}).get("name", ""), "verdict": self.summary.get("verdict", "")},
+        )
+
+
+def simulate(scenario: Scenario = "disc-pad", *, duration: Optional[float] = None, set=None, **params) -> Run:
+    """Integrate a scenario (``squeal simulate``): a :class:`Run`."""
+    return Run(_squeal.simulate(*_source(scenario), _sets(set, params), duration))
+
+
+class Stability:
+    """Eigen-analysis of steady sliding (``squeal stability``).
+
+    ``eigenvalues`` (complex128, all 2n, by growth rate descending),
+    ``growth_rates`` (Re λ, 1/s), ``frequencies_hz`` (|Im λ|/2π),
+    ``damping_ratios`` (−σ/|λ|), ``modes`` (complex mode shapes, 2n × n:
+    position part of each eigenvector over its largest component),
+    ``dominant`` (dof of each mode), ``dofs``, ``stable``, ``neutral``,
+    ``least_stable`` (dict of the least stable mode), ``levers`` (list of
+    dicts ``param, from, to, freq_hz``: one-parameter changes that flip the
+    verdict), ``to_dict()`` (the document of ``squeal stability --json``).
+    """
+
+    def __init__(self, raw: Dict[str, Any]):
+        self.eigenvalues: np.ndarray = raw["eigenvalues"]
+        self.frequencies_hz: np.ndarray = raw["frequencies_hz"]
+        self.damping_ratios: np.ndarray = raw["damping_ratios"]
+        self.modes: np.ndarray = raw["modes"]
+        self.dominant: List[str] = list(raw["dominant"])
+        self.dofs: List[str] = list(raw["dofs"])
+        self.stable: bool = raw["stable"]
+        self.neutral: bool = raw["neutral"]
+        self._text: str = raw["document"]
+        self._doc: Optional[Dict[str, Any]] = None
+        k = raw["least_stable"]
+        lam = self.eigenvalues[k]
+        self.least_stable: Dict[str, Any] = {
+            "re": float(lam.real), "im": float(lam.imag),
+            "freq_hz": float(self.frequencies_hz[k]), "dominant": self.dominant[k],
+        }
+
+    def _document(self) -> Dict[str, Any]:
+        if self._doc is None:
+            self._doc = json.loads(self._text)
+        return self._doc
+
+    @property
+    def levers(self) -> List[Dict[str, Any]]:
+        """One-parameter changes that flip the verdict: ``param, from, to, freq_hz``."""
+        return self._document()["levers"]
+
+    @property
+    def growth_rates(self) -> np.ndarray:
+        """Re λ of every eigenvalue (1/s)."""
+        return self.eigenvalues.real.copy()
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The document ``squeal stability --json`` prints."""
+        return json.loads(self._text)
+
+    def __repr__(self) -> str:
+        verdict = "stable" if self.stable else "neutral" if self.neutral else "unstable"
+        return f"<squeal.Stability {verdict}: max growth rate {self.eigenvalues[0].real:+.6e} 1/s>"
+
+
+def stability(scenario: Scenario = "disc-pad", *, levers: bool = True, set=None, **params) -> Stability:
+    """Stability of steady sliding (``squeal stability``): a :class:`Stability`.
+    ``levers=False`` skips the search for verdict-flipping parameter changes
+    (hundreds of analyses)."""
+    return Stability(_squeal.stability(*_source(scenario), _sets(set, params), levers))
+
+
+def _axis(a: Sequence[Any], what: str) -> Axis:
+    try:
+        name, lo, hi, n = a
+        return (str(name), float(lo), float(hi), int(n))
+    except (TypeError, ValueError):
+        raise ScenarioError(f"{what} {a!r}: expected (NAME, LO, HI, N)") from None
+
+
+def map(
+    scenario: Scenario = "disc-pad",
+    *,
+    x: Axis = ("V", 0.5, 20.0, 40),
+    y: Axis = ("N", 100.0, 3000.0, 30),
+    transient: bool = False,
+    log_x: bool = False,
+    log_y: bool = False,
+    duration: Optional[float] = None,
+    threads: Optional[int] = None,
+    set=None,
+    **params,
+):
+    """Stability over a grid of two parameters (``squeal map``), in parallel
+    and deterministic (any ``threads``: the same bits).
+
+    An ``xarray.Dataset`` with coordinates named after the parameters and
+    variables ``max_growth_rate`` (1/s, NaN where steady sliding does not
+    exist) and ``freq_hz``, plus ``outcome``, ``rms_tangential``,
+    ``stick_fraction``, ``t_end`` and ``agree`` with ``transient=True``;
+    without xarray a dict of the same names (2-D arrays, y × x, and the two
+    coordinate arrays)."""
+    raw = _squeal.stability_map(
+        *_source(scenario), _sets(set, params), _axis(x, "x"), _axis(y, "y"),
+        log_x, log_y, transient, duration, threads,
+    )
+    xn, yn = raw["x_name"], raw["y_name"]
+    shape = (len(raw["y"]), len(raw["x"]))
+    names = ["max_growth_rate", "freq_hz", "outcome", "rms_tangential", "stick_fraction", "t_end", "agree"]
+    grids = {k: np.asarray(raw[k]).reshape(shape) for k in names if k in raw}
+    try:
+        import xarray as xr
+    except ImportError:
+        return {xn: raw["x"], yn: raw["y"], **grids}
+    ds = xr.Dataset(
+        {k: ((yn, xn), v) for k, v in grids.items()},
+        coords={xn: raw["x"], yn: raw["y"]},
+    )
+    ds[xn].attrs["units"] = raw["x_unit"]
+    ds[yn].attrs["units"] = raw["y_unit"]
+    ds["max_growth_rate"].attrs["units"] = "1/s"
+    ds["freq_hz"].attrs["units"] = "Hz"
+    return ds
+
+
+def critical(
+    scenario: Scenario = "disc-pad",
+    *,
+    param: Tuple[str, float, float] = ("V", 1.0, 16.5),
+    grid: int = 64,
+    set=None,
+    **params,
+) -> Dict[str, Any]:
+    """Where steady sliding changes stability (``squeal critical``):
+    ``{"param", "value", "freq_hz"}`` (plus ``direction`` and
+    ``from_neutral`` when found; ``value`` and ``freq_hz`` None when nothing
+    crosses in the interval; ``modal``: how the eigenvalues are computed) —
+    the document of ``squeal critical --json``."""
+    try:
+        name, lo, hi = param
+        lo, hi = float(lo), float(hi)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"param {param!r}: expected (NAME, LO, HI)") from None
+    return json.loads(_squeal.critical(*_source(scenario), _sets(set, params), str(name), lo, hi, int(grid)))
+
+
+def sweep(
+    scenario: Scenario = "disc-pad",
+    *,
+    param: Axis,
+    set=None,
+    **params,
+) -> Dict[str, Any]:
+    """Eigenvalues tracked along one parameter (``squeal sweep``):
+    ``{"param", "values", "eigenvalues" (values × branches, complex128),
+    "growth_rates", "frequencies_hz", "listed"}`` (``listed``: the branches
+    the CLI lists, one per mode)."""
+    raw = _squeal.sweep(*_source(scenario), _sets(set, params), _axis(param, "param"))
+    lam = raw["eigenvalues"]
+    return {
+        "param": raw["param"],
+        "values": raw["values"],
+        "eigenvalues": lam,
+        "growth_rates": lam.real.copy(),
+        "frequencies_hz": np.abs(lam.imag) / (2 * np.pi),
+        "listed": list(raw["listed"]),
+    }

@@ -1,0 +1,488 @@
+//! `squeal._squeal`: the compiled half of the Python package `squeal`.
+//!
+//! Every function here only converts types between Python/NumPy and
+//! [`squeal_study`], which computes exactly what the command line computes
+//! (the friendly classes live in `squeal/__init__.py`). Each computation runs
+//! on a worker thread with the GIL released ([`compute`]); the calling thread
+//! wakes every [`POLL`] to let Python handle signals, and on
+//! `KeyboardInterrupt` sets the study's [`Cancel`] token, joins the worker
+//! and re-raises. No panic crosses into Python: a panicking worker becomes a
+//! `SquealError`.
+
+use numpy::ndarray::Array2;
+use numpy::{Complex64, IntoPyArray};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use squeal_study::map::{self, Axis};
+use squeal_study::scenario::{self, Source};
+use squeal_study::{Cancel, NoProgress, Scenario, StudyError};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::{Condvar, Mutex, PoisonError};
+use std::time::Duration;
+
+create_exception!(
+    _squeal,
+    SquealError,
+    PyRuntimeError,
+    "A computation failed (numerical trouble, with the time and the cause), or was interrupted."
+);
+create_exception!(
+    _squeal,
+    ScenarioError,
+    PyValueError,
+    "Bad input: the message names the offending key and value (the CLI's exit code 2)."
+);
+
+/// How often the calling thread looks for signals while a worker computes.
+const POLL: Duration = Duration::from_millis(20);
+
+fn study_err(e: StudyError) -> PyErr {
+    match e {
+        StudyError::Input(i) => ScenarioError::new_err(i.0),
+        StudyError::Interrupted => PyKeyboardInterrupt::new_err("interrupted"),
+        other => SquealError::new_err(other.to_string()),
+    }
+}
+
+fn input_err(e: scenario::InputError) -> PyErr {
+    ScenarioError::new_err(e.0)
+}
+
+fn panic_err(panic: Box<dyn std::any::Any + Send>) -> PyErr {
+    let why = panic
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| panic.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown cause".into());
+    SquealError::new_err(format!("internal error (a bug): {why}"))
+}
+
+/// Run `work` — microseconds of work, nothing to interrupt — on this thread
+/// with the GIL released (a worker thread would cost more than the work).
+fn compute_quick<T, F>(py: Python<'_>, work: F) -> PyResult<T>
+where
+    T: Send,
+    F: FnOnce(&Cancel) -> Result<T, StudyError> + Send,
+{
+    let cancel = Cancel::new();
+    match py.allow_threads(|| catch_unwind(AssertUnwindSafe(|| work(&cancel)))) {
+        Ok(r) => r.map_err(study_err),
+        Err(panic) => Err(panic_err(panic)),
+    }
+}
+
+/// Run `work` on a worker thread with the GIL released; see the module docs.
+fn compute<T, F>(py: Python<'_>, work: F) -> PyResult<T>
+where
+    T: Send,
+    F: FnOnce(&Cancel) -> Result<T, StudyError> + Send,
+{
+    let cancel = Cancel::new();
+    // Set by the worker when it is done; the caller waits on it in slices of POLL.
+    let done = (Mutex::new(false), Condvar::new());
+    std::thread::scope(|s| {
+        let (cancel, done) = (&cancel, &done);
+        let worker = s.spawn(move || {
+            let r = catch_unwind(AssertUnwindSafe(|| work(cancel)));
+            *done.0.lock().unwrap_or_else(PoisonError::into_inner) = true;
+            done.1.notify_all();
+            r
+        });
+        loop {
+            let finished = py.allow_threads(|| {
+                let g = done.0.lock().unwrap_or_else(PoisonError::into_inner);
+                let (g, _) = done
+                    .1
+                    .wait_timeout_while(g, POLL, |d| !*d)
+                    .unwrap_or_else(PoisonError::into_inner);
+                *g
+            });
+            if finished {
+                break;
+            }
+            if let Err(e) = py.check_signals() {
+                cancel.cancel();
+                py.allow_threads(|| {
+                    let _ = worker.join();
+                });
+                return Err(e);
+            }
+        }
+        match py.allow_threads(|| worker.join()) {
+            Ok(Ok(r)) => r.map_err(study_err),
+            Ok(Err(panic)) | Err(panic) => Err(panic_err(panic)),
+        }
+    })
+}
+
+/// A scenario source as Python hands it over: `kind` is `"spec"` (a
+/// built-in name or a path) or `"json"` (a dict, serialised by Python's
+/// `json`, which round-trips floats).
+fn with_source<T>(
+    kind: &str,
+    text: &str,
+    f: impl FnOnce(Source<'_>) -> Result<T, StudyError>,
+) -> PyResult<T> {
+    match kind {
+        "spec" => f(Source::Spec(text)).map_err(study_err),
+        "json" => {
+            let table: toml::Table = serde_json::from_str(text).map_err(|e| {
+                ScenarioError::new_err(format!(
+                    "scenario dict: not a TOML document ({e}; null values have no TOML form)"
+                ))
+            })?;
+            f(Source::Table(&table)).map_err(study_err)
+        }
+        other => Err(PyValueError::new_err(format!(
+            "scenario source kind {other}"
+        ))),
+    }
+}
+
+fn resolve(kind: &str, text: &str, sets: &[String]) -> PyResult<Scenario> {
+    with_source(kind, text, |s| Ok(scenario::resolve(s, sets)?))
+}
+
+fn json_text(v: &serde_json::Value) -> PyResult<String> {
+    serde_json::to_string(v).map_err(|e| SquealError::new_err(e.to_string()))
+}
+
+/// The built-in scenario names.
+#[pyfunction]
+fn scenarios() -> Vec<&'static str> {
+    scenario::BUILTINS.to_vec()
+}
+
+/// A resolved scenario: its TOML text and the same document as JSON text
+/// (Python parses that into the dict `squeal.scenario` returns).
+#[pyfunction]
+fn scenario_doc(kind: &str, text: &str, sets: Vec<String>) -> PyResult<(String, String)> {
+    let toml_text = resolve(kind, text, &sets)?.to_toml();
+    let table: toml::Table =
+        toml::from_str(&toml_text).map_err(|e| SquealError::new_err(e.to_string()))?;
+    let json = serde_json::to_string(&table).map_err(|e| SquealError::new_err(e.to_string()))?;
+    Ok((toml_text, json))
+}
+
+/// Simulate: a dict with `columns`, `data` (samples × columns, Fortran
+/// order: each column contiguous), the events, the summary (JSON text) and
+/// the spectra of the analysed velocities.
+#[pyfunction]
+#[pyo3(signature = (kind, text, sets, duration=None))]
+fn simulate<'py>(
+    py: Python<'py>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    duration: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let sc = with_source(kind, text, |s| scenario::resolve_run(s, &sets, duration))?;
+    let (run, summary, spectra) = compute(py, |cancel| {
+        let start = std::time::Instant::now();
+        let mut run = squeal_study::run::run(&sc, &NoProgress, cancel)?;
+        run.integrate_s = start.elapsed().as_secs_f64();
+        let an = squeal_study::analysis::analyse(
+            &run,
+            &sc.model.channels(),
+            &squeal_study::analysis::SpectrumSettings::default(),
+            sc.validity,
+            &[],
+        );
+        let mut summary = squeal_study::analysis::summary_json(&sc, &run, &an);
+        summary["timing"] = serde_json::json!({ "integrate_s": run.integrate_s });
+        let spectra: Vec<(String, Vec<f64>, Vec<f64>)> = an
+            .spectra
+            .into_iter()
+            .map(|c| (c.signal, c.spectrum.freq, c.spectrum.psd))
+            .collect();
+        Ok((run, summary, spectra))
+    })?;
+    let (rows, cols) = (run.len(), run.columns.len());
+    let mut flat = Vec::with_capacity(rows * cols);
+    for c in &run.data {
+        flat.extend_from_slice(c);
+    }
+    let data = Array2::from_shape_vec((cols, rows), flat)
+        .map_err(|e| SquealError::new_err(e.to_string()))?
+        .reversed_axes();
+    let out = PyDict::new(py);
+    out.set_item("columns", &run.columns)?;
+    out.set_item("data", data.into_pyarray(py))?;
+    let ev_t: Vec<f64> = run.events.iter().map(|e| e.0).collect();
+    let ev_kind: Vec<&str> = run.events.iter().map(|e| e.1.as_str()).collect();
+    let ev_contact: Vec<&str> = run
+        .event_contacts
+        .iter()
+        .map(|&i| run.contact_names.get(i).map_or("", String::as_str))
+        .collect();
+    out.set_item("event_t", ev_t.into_pyarray(py))?;
+    out.set_item("event_kind", ev_kind)?;
+    out.set_item("event_contact", ev_contact)?;
+    out.set_item("summary", json_text(&summary)?)?;
+    out.set_item("sample_rate", run.sample_rate)?;
+    let sp = PyDict::new(py);
+    for (name, f, p) in spectra {
+        sp.set_item(name, (f.into_pyarray(py), p.into_pyarray(py)))?;
+    }
+    out.set_item("spectra", sp)?;
+    Ok(out)
+}
+
+/// Stability of steady sliding: a dict of arrays and the JSON document.
+#[pyfunction]
+fn stability<'py>(
+    py: Python<'py>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    levers: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let sc = resolve(kind, text, &sets)?;
+    // Without levers the analysis takes microseconds: no worker thread.
+    let work = |_: &Cancel| {
+        let an = squeal_study::stability::analyse(&sc.model)
+            .map_err(|e| squeal_study::feasible::stability_failure(&sc.model, e))?;
+        let lev = if levers {
+            squeal_study::stability::levers_if_searched(&sc.model)
+        } else {
+            Vec::new()
+        };
+        Ok((an, lev))
+    };
+    let (an, lev) = if levers {
+        compute(py, work)?
+    } else {
+        compute_quick(py, work)?
+    };
+    let n2 = an.eigen.len();
+    let eig: Vec<Complex64> = an
+        .eigen
+        .iter()
+        .map(|e| Complex64::new(e.re, e.im))
+        .collect();
+    let shapes: Vec<Vec<Complex64>> = an
+        .eigen
+        .iter()
+        .map(squeal_core::stability::modal::mode_shape)
+        .collect();
+    let n = shapes.first().map_or(0, Vec::len);
+    let modes = Array2::from_shape_vec((n2, n), shapes.concat())
+        .map_err(|e| SquealError::new_err(e.to_string()))?;
+    let out = PyDict::new(py);
+    out.set_item("eigenvalues", eig.into_pyarray(py))?;
+    out.set_item(
+        "frequencies_hz",
+        an.eigen
+            .iter()
+            .map(|e| e.freq_hz)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    out.set_item(
+        "damping_ratios",
+        an.eigen
+            .iter()
+            .map(|e| e.damping_ratio)
+            .collect::<Vec<_>>()
+            .into_pyarray(py),
+    )?;
+    out.set_item("modes", modes.into_pyarray(py))?;
+    out.set_item(
+        "dominant",
+        an.eigen
+            .iter()
+            .map(|e| e.dominant_name.as_str())
+            .collect::<Vec<_>>(),
+    )?;
+    out.set_item("dofs", &sc.model.state_names()[..n])?;
+    out.set_item("stable", an.stable)?;
+    out.set_item("neutral", an.neutral)?;
+    out.set_item("least_stable", an.least_stable)?;
+    out.set_item(
+        "document",
+        json_text(&squeal_study::stability::document(&sc, &an, &lev))?,
+    )?;
+    Ok(out)
+}
+
+fn axis(spec: (String, f64, f64, usize), flag: &str, log: bool, sc: &Scenario) -> PyResult<Axis> {
+    let text = format!("{}={}:{}:{}", spec.0, spec.1, spec.2, spec.3);
+    map::parse_axis(&text, flag, log, &sc.model).map_err(input_err)
+}
+
+/// A stability map (and the transient outcome when asked): a dict of the
+/// axes and flat row-major (y then x) arrays, in the CLI's point order.
+#[pyfunction]
+#[pyo3(signature = (kind, text, sets, x, y, log_x, log_y, transient, duration=None, threads=None))]
+fn stability_map<'py>(
+    py: Python<'py>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    x: (String, f64, f64, usize),
+    y: (String, f64, f64, usize),
+    log_x: bool,
+    log_y: bool,
+    transient: bool,
+    duration: Option<f64>,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let sc = if transient || duration.is_some() {
+        with_source(kind, text, |s| scenario::resolve_run(s, &sets, duration))?
+    } else {
+        resolve(kind, text, &sets)?
+    };
+    let xa = axis(x, "--x", log_x, &sc)?;
+    let ya = axis(y, "--y", log_y, &sc)?;
+    map::check_distinct(&xa, &ya).map_err(input_err)?;
+    let pool = match threads {
+        Some(0) => return Err(ScenarioError::new_err("threads 0: must be at least 1")),
+        Some(n) => Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| SquealError::new_err(e.to_string()))?,
+        ),
+        None => None,
+    };
+    let (lin, trans) = compute(py, |cancel| {
+        let work = || {
+            let points = map::all_points(&xa, &ya);
+            let lin = map::linear_grid(&sc.model, &xa, &ya, &points, &NoProgress, cancel)?;
+            let trans = if transient {
+                Some(map::transient_grid(
+                    &sc,
+                    &xa,
+                    &ya,
+                    &points,
+                    &NoProgress,
+                    cancel,
+                )?)
+            } else {
+                None
+            };
+            Ok((lin, trans))
+        };
+        match &pool {
+            Some(p) => p.install(work),
+            None => work(),
+        }
+    })?;
+    let out = PyDict::new(py);
+    out.set_item("x_name", &xa.name)?;
+    out.set_item("y_name", &ya.name)?;
+    out.set_item("x_unit", map::unit_of(&sc.model, &xa.name))?;
+    out.set_item("y_unit", map::unit_of(&sc.model, &ya.name))?;
+    out.set_item("x", xa.values.clone().into_pyarray(py))?;
+    out.set_item("y", ya.values.clone().into_pyarray(py))?;
+    out.set_item(
+        "max_growth_rate",
+        lin.iter().map(|p| p.0).collect::<Vec<_>>().into_pyarray(py),
+    )?;
+    out.set_item(
+        "freq_hz",
+        lin.iter().map(|p| p.1).collect::<Vec<_>>().into_pyarray(py),
+    )?;
+    if let Some(t) = trans {
+        out.set_item("outcome", t.iter().map(|o| o.class).collect::<Vec<_>>())?;
+        out.set_item(
+            "rms_tangential",
+            t.iter().map(|o| o.rms).collect::<Vec<_>>().into_pyarray(py),
+        )?;
+        out.set_item(
+            "stick_fraction",
+            t.iter()
+                .map(|o| o.stick_fraction)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        out.set_item(
+            "t_end",
+            t.iter()
+                .map(|o| o.t_end)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        out.set_item(
+            "agree",
+            t.iter()
+                .zip(&lin)
+                .map(|(o, (s, _))| map::agree(*s, o))
+                .collect::<Vec<_>>(),
+        )?;
+    }
+    Ok(out)
+}
+
+/// The critical value of `name` in `[lo, hi]`: `(value, freq_hz, direction,
+/// from_neutral)` or `None`.
+#[pyfunction]
+fn critical(
+    py: Python<'_>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    name: String,
+    lo: f64,
+    hi: f64,
+    grid: usize,
+) -> PyResult<Option<String>> {
+    let sc = resolve(kind, text, &sets)?;
+    let found = compute(py, |cancel| {
+        squeal_study::critical::locate(&sc.model, &name, lo, hi, grid, cancel)
+    })?;
+    let mut doc = match found {
+        None => serde_json::json!({ "param": name, "value": null, "freq_hz": null }),
+        Some(c) => serde_json::json!({
+            "param": name, "value": c.value, "freq_hz": c.freq_hz,
+            "direction": c.direction, "from_neutral": c.from_neutral,
+        }),
+    };
+    doc["modal"] = squeal_study::stability::modal_options_json(&sc.model);
+    Ok(Some(json_text(&doc)?))
+}
+
+/// An eigenvalue sweep: values, the eigenvalues (values × branches) and the
+/// indices of the listed branches.
+#[pyfunction]
+fn sweep<'py>(
+    py: Python<'py>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    param: (String, f64, f64, usize),
+) -> PyResult<Bound<'py, PyDict>> {
+    let sc = resolve(kind, text, &sets)?;
+    let spec = format!("{}={}:{}:{}", param.0, param.1, param.2, param.3);
+    let ax = map::parse_axis(&spec, "--param", false, &sc.model).map_err(input_err)?;
+    let sw = compute(py, |cancel| {
+        squeal_study::sweep::sweep_model(&sc.model, &ax.name, &ax.values, &spec, cancel)
+    })?;
+    let k = sw.values.len();
+    let b = sw.lambda.first().map_or(0, Vec::len);
+    let lambda = Array2::from_shape_vec((k, b), sw.lambda.concat())
+        .map_err(|e| SquealError::new_err(e.to_string()))?;
+    let out = PyDict::new(py);
+    out.set_item("param", &ax.name)?;
+    out.set_item("values", sw.values.clone().into_pyarray(py))?;
+    out.set_item("eigenvalues", lambda.into_pyarray(py))?;
+    out.set_item("listed", sw.listed.clone())?;
+    Ok(out)
+}
+
+/// The compiled module.
+#[pymodule]
+fn _squeal(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("SquealError", m.py().get_type::<SquealError>())?;
+    m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;
+    m.add_function(wrap_pyfunction!(scenarios, m)?)?;
+    m.add_function(wrap_pyfunction!(scenario_doc, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(stability, m)?)?;
+    m.add_function(wrap_pyfunction!(stability_map, m)?)?;
+    m.add_function(wrap_pyfunction!(critical, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    Ok(())
+}

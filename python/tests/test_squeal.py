@@ -1,0 +1,246 @@
+"""The Python package against the CLI's own outputs (exact: same bits), its
+shapes, dtypes and errors, determinism over threads, and Ctrl-C."""
+
+import json
+import os
+import pathlib
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pytest
+
+import squeal
+
+SHORT = 0.05  # s: a short run still crosses stick-slip events at these settings
+
+
+def same_bits(a, b):
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    assert a.shape == b.shape, (a.shape, b.shape)
+    np.testing.assert_array_equal(a.view(np.uint64), b.view(np.uint64))
+
+
+def test_simulate_equals_cli_series_bits_and_summary(cli, tmp_path):
+    out = tmp_path / "run"
+    cli("simulate", "disc-pad", "--set", "N=2000", "--set", "V=2.5", "--duration", str(SHORT),
+        "--format", "npy", "--no-plots", "--out", str(out))
+    series = np.load(out / "series.npy")
+    run = squeal.simulate("disc-pad", duration=SHORT, N=2000, set={"V": 2.5})
+    same_bits(run.data, series)
+    cli_summary = json.loads((out / "summary.json").read_text())
+    for d in (cli_summary, run.summary):
+        d.pop("timing", None)
+        d.pop("audio", None)
+    assert run.summary == cli_summary
+    events = (out / "events.csv").read_text().splitlines()[1:]
+    assert len(events) == len(run.events["t"])
+    for line, t, k, c in zip(events, run.events["t"], run.events["kind"], run.events["contact"]):
+        ct, ck, cc = line.split(",")
+        assert (float(ct), ck, cc) == (t, k, c)
+
+
+def test_run_shapes_dtypes_and_columns():
+    run = squeal.simulate(duration=SHORT)
+    assert run.data.dtype == np.float64 and run.data.ndim == 2
+    assert run.data.shape == (len(run.t), len(run.columns))
+    assert run.columns[0] == "t" and "vx_p" in run.columns
+    assert run.t.dtype == np.float64 and run.t[0] == 0.0
+    np.testing.assert_allclose(run.t[-1], SHORT)
+    assert run["vx_p"].shape == run.t.shape
+    assert np.shares_memory(run["vx_p"], run.data)  # a view, no copy
+    assert run.events["t"].dtype == np.float64
+    assert run.events["kind"].shape == run.events["contact"].shape == run.events["t"].shape
+    assert run.summary["verdict"] in ("squeal", "quiet", "steady", "decaying") or isinstance(run.summary["verdict"], str)
+    f, p = run.spectra["vx_p"]
+    assert f.shape == p.shape and f.dtype == p.dtype == np.float64
+    with pytest.raises(KeyError, match="nope"):
+        run["nope"]
+
+
+def test_to_pandas_and_to_xarray():
+    run = squeal.simulate(duration=SHORT)
+    pd = pytest.importorskip("pandas")
+    df = run.to_pandas()
+    assert isinstance(df, pd.DataFrame) and list(df.columns) == run.columns[1:]
+    same_bits(df["vx_p"].to_numpy(), run["vx_p"])
+    xr = pytest.importorskip("xarray")
+    ds = run.to_xarray()
+    assert isinstance(ds, xr.Dataset)
+    same_bits(ds["vx_p"].values, run["vx_p"])
+
+
+def test_stability_equals_cli_json_bits(cli):
+    doc = json.loads(cli("stability", "disc-pad", "--set", "V=2", "--json"))
+    st = squeal.stability("disc-pad", V=2.0)
+    cli_eig = np.array([complex(e["re"], e["im"]) for e in doc["eigenvalues"]])
+    assert st.eigenvalues.dtype == np.complex128
+    same_bits(st.eigenvalues.real, cli_eig.real)
+    same_bits(st.eigenvalues.imag, cli_eig.imag)
+    same_bits(st.frequencies_hz, [e["freq_hz"] for e in doc["eigenvalues"]])
+    same_bits(st.damping_ratios, [e["damping_ratio"] for e in doc["eigenvalues"]])
+    assert st.to_dict() == doc
+    assert st.stable == doc["stable"] and st.least_stable == doc["least_stable"]
+    assert st.levers == doc["levers"]
+
+
+def test_stability_shapes_and_modes():
+    st = squeal.stability("disc-pad", levers=False)
+    n2 = len(st.eigenvalues)
+    n = len(st.dofs)
+    assert n2 == 2 * n == 8  # the 4-dof model: all 2n eigenvalues
+    assert st.growth_rates.dtype == np.float64 and st.growth_rates.shape == (n2,)
+    assert st.modes.shape == (n2, n) and st.modes.dtype == np.complex128
+    # The shapes are normalised: the largest position component is exactly 1.
+    np.testing.assert_allclose(np.abs(st.modes).max(axis=1), 1.0, rtol=0, atol=1e-15)
+    # Amplitudes and phases are those the CLI's JSON lists (NumPy's |z| and
+    # angle round differently from Rust's hypot/atan2: to 1 ulp).
+    doc = st.to_dict()
+    for k, e in enumerate(doc["eigenvalues"]):
+        np.testing.assert_allclose(np.abs(st.modes[k]), [s["amplitude"] for s in e["shape"]], rtol=1e-15)
+        amp = np.abs(st.modes[k]) > 1e-12
+        np.testing.assert_allclose(np.degrees(np.angle(st.modes[k]))[amp],
+                                   np.array([s["phase_deg"] for s in e["shape"]])[amp], rtol=1e-13, atol=1e-12)
+    assert st.growth_rates[0] == st.growth_rates.max()
+
+
+def test_map_equals_cli_csv_bits(cli, tmp_path):
+    out = tmp_path / "map"
+    cli("map", "disc-pad", "--x", "V=0.5:20:7", "--y", "N=100:3000:5", "--out", str(out))
+    rows = [line.split(",") for line in (out / "map.csv").read_text().splitlines()[1:]]
+    cli_arr = np.array([[float(v) for v in r] for r in rows])
+    m = squeal.map("disc-pad", x=("V", 0.5, 20, 7), y=("N", 100, 3000, 5))
+    sigma = np.asarray(m["max_growth_rate"])
+    assert sigma.shape == (5, 7)
+    same_bits(sigma.ravel(), cli_arr[:, 2])
+    same_bits(np.asarray(m["freq_hz"]).ravel(), cli_arr[:, 3])
+    same_bits(np.asarray(m["V"]), np.unique(cli_arr[:, 0]))
+    same_bits(np.asarray(m["N"]), np.unique(cli_arr[:, 1]))
+
+
+def test_map_is_the_same_with_1_and_2_threads():
+    a = squeal.map(x=("V", 0.5, 20, 9), y=("c_px", 0.05, 0.5, 8), threads=1)
+    b = squeal.map(x=("V", 0.5, 20, 9), y=("c_px", 0.05, 0.5, 8), threads=2)
+    same_bits(a["max_growth_rate"], b["max_growth_rate"])
+    same_bits(a["freq_hz"], b["freq_hz"])
+
+
+def test_map_xarray_coordinates_named_after_parameters():
+    xr = pytest.importorskip("xarray")
+    ds = squeal.map(x=("V", 1, 10, 4), y=("N", 500, 2000, 3))
+    assert isinstance(ds, xr.Dataset)
+    assert ds["max_growth_rate"].dims == ("N", "V")
+    assert ds["V"].attrs["units"] == "m/s"
+
+
+def test_transient_map_point_outcomes():
+    m = squeal.map(x=("V", 1, 10, 2), y=("N", 500, 2000, 2), transient=True, duration=0.05)
+    assert np.asarray(m["outcome"]).shape == (2, 2)
+    assert np.asarray(m["agree"]).shape == (2, 2)
+
+
+def test_critical_equals_cli_json(cli):
+    doc = json.loads(cli("critical", "disc-pad", "--param", "V=1:16.5", "--json"))
+    c = squeal.critical("disc-pad", param=("V", 1.0, 16.5))
+    assert c == doc
+    assert c["value"] is not None and 1.0 < c["value"] < 16.5
+
+
+def test_critical_none_when_nothing_crosses(cli):
+    doc = json.loads(cli("critical", "disc-pad", "--param", "V=30:40", "--json"))
+    c = squeal.critical("disc-pad", param=("V", 30.0, 40.0))
+    assert c == doc
+    assert (c["param"], c["value"], c["freq_hz"]) == ("V", None, None)
+
+
+def test_sweep_shapes():
+    sw = squeal.sweep(param=("c_px", 0.05, 0.5, 11))
+    assert sw["eigenvalues"].shape == (11, 8) and sw["eigenvalues"].dtype == np.complex128
+    assert len(sw["listed"]) == 4
+
+
+def test_bad_key_raises_scenario_error_naming_it():
+    with pytest.raises(squeal.ScenarioError, match="bogus_key") as e:
+        squeal.simulate(duration=SHORT, bogus_key=1.0)
+    assert isinstance(e.value, ValueError)
+    with pytest.raises(squeal.ScenarioError, match="N"):
+        squeal.stability(N=-5.0)
+    with pytest.raises(squeal.ScenarioError, match="no-such-scenario"):
+        squeal.stability("no-such-scenario")
+    with pytest.raises(squeal.ScenarioError, match="--x and --y both vary V"):
+        squeal.map(x=("V", 1, 2, 3), y=("V", 1, 2, 3))
+
+
+def test_error_messages_are_the_clis(cli):
+    exe = __import__("conftest")._find_cli()
+    r = subprocess.run([exe, "stability", "disc-pad", "--set", "bogus_key=1"], capture_output=True, text=True)
+    assert r.returncode == 2
+    with pytest.raises(squeal.ScenarioError) as e:
+        squeal.stability(bogus_key=1)
+    assert str(e.value) in r.stderr
+
+
+def test_dict_scenario_equals_its_toml(tmp_path):
+    d = squeal.scenario("disc-pad")
+    assert isinstance(d, dict) and d["name"] == "disc-pad"
+    path = tmp_path / "mine.toml"
+    toml_text = squeal._squeal.scenario_doc("spec", "disc-pad", [])[0]
+    path.write_text(toml_text)
+    a = squeal.simulate(d, duration=SHORT)
+    b = squeal.simulate(path, duration=SHORT)
+    c = squeal.simulate("disc-pad", duration=SHORT)
+    same_bits(a.data, b.data)
+    same_bits(a.data, c.data)
+    st_a, st_b = squeal.stability(d, levers=False), squeal.stability(str(path), levers=False)
+    same_bits(st_a.eigenvalues.view(np.float64), st_b.eigenvalues.view(np.float64))
+
+
+def test_scenarios_lists_builtins():
+    names = squeal.scenarios()
+    assert "disc-pad" in names
+    for n in names:
+        assert squeal.scenario(n)["name"] == n
+
+
+def _interrupt_after(delay):
+    script = textwrap.dedent(
+        """
+        import sys, time, squeal
+        print("start", flush=True)
+        t0 = time.monotonic()
+        try:
+            squeal.simulate("disc-pad", duration=140.0, sample_rate=70000.0)
+        except KeyboardInterrupt:
+            print("interrupted", time.monotonic() - t0, flush=True)
+            sys.exit(0)
+        print("finished", flush=True)
+        sys.exit(1)
+        """
+    )
+    p = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "start"
+    time.sleep(delay)
+    sent = time.monotonic()
+    p.send_signal(signal.SIGINT)
+    try:
+        out, _ = p.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        raise AssertionError("simulate did not stop within 10 s of SIGINT")
+    elapsed = time.monotonic() - sent
+    assert p.returncode == 0, out
+    assert out.startswith("interrupted"), out
+    assert elapsed < 2.0, elapsed
+
+
+def test_ctrl_c_interrupts_a_long_simulation_promptly():
+    _interrupt_after(3.0)
+
+
+@pytest.mark.xfail(reason="known bug, not yet understood: a SIGINT ~1 s after import (during "
+                   "scenario checks or the first second of the run) is sometimes not seen", strict=False)
+def test_ctrl_c_soon_after_the_start():
+    _interrupt_after(1.0)
