@@ -332,3 +332,49 @@ def sweep(
         "frequencies_hz": np.abs(lam.imag) / (2 * np.pi),
         "listed": list(raw["listed"]),
     }
+
+
+def cycle(
+    scenario: Scenario = "disc-pad",
+    *,
+    section: Optional[str] = None,
+    settle_steps: int = 20_000_000,
+    settle_time: float = 1000.0,
+    settle_tol: float = 1e-2,
+    set=None,
+    **params,
+) -> Dict[str, Any]:
+    """The limit cycle the scenario settles on (``squeal cycle --json``):
+    the CLI's document (``period``, ``multipliers`` as ``{re, im, abs}``,
+    ``stable``, ``amplitude``, ``events_per_period``, the shooting residual,
+    …) plus ``orbit`` (one period, rows × ``orbit_columns``, float64) and
+    ``orbit_events`` (the event kind on each row, "" for none).
+    ``section`` is ``"STATE"`` or ``"STATE=LEVEL"`` as ``--section``."""
+    raw = _squeal.cycle(
+        *_source(scenario),
+        _sets(set, params),
+        int(settle_steps),
+        float(settle_time),
+        float(settle_tol),
+        section,
+    )
+    doc = json.loads(raw["document"])
+    if "orbit" in raw:
+        doc["orbit_columns"] = list(raw["orbit_columns"])
+        doc["orbit"] = raw["orbit"]
+        doc["orbit_events"] = list(raw["orbit_events"])
+    return doc
+
+
+def branch(
+    scenario: Scenario = "disc-pad",
+    *,
+    param: Axis,
+    set=None,
+    **params,
+) -> Dict[str, Any]:
+    """Continuation of the limit cycle over one parameter
+    (``squeal branch --json``): the CLI's document (``points`` with period,
+    amplitudes, multipliers and stability; ``bifurcations``; ``segments``;
+    ``hopf``). ``param`` is ``(NAME, LO, HI, N)`` as ``--param``."""
+    return json.loads(_squeal.branch(*_source(scenario), _sets(set, params), _axis(param, "param")))

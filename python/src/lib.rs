@@ -472,6 +472,75 @@ fn sweep<'py>(
     Ok(out)
 }
 
+/// A limit cycle (`squeal cycle --json`): the document as JSON text, and the
+/// orbit over one period (column names, rows × columns, event kinds per row).
+#[pyfunction]
+#[pyo3(signature = (kind, text, sets, settle_steps, settle_time, settle_tol, section=None))]
+fn cycle<'py>(
+    py: Python<'py>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    settle_steps: u64,
+    settle_time: f64,
+    settle_tol: f64,
+    section: Option<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let sc = resolve(kind, text, &sets)?;
+    let opts = squeal_study::cycle::checked_options(
+        &sc,
+        settle_steps,
+        settle_time,
+        settle_tol,
+        section.as_deref(),
+    )
+    .map_err(study_err)?;
+    let found = compute(py, |cancel| {
+        squeal_study::cycle::of_scenario(&sc, &opts, true, cancel)
+    })?;
+    let mut doc = found.to_json();
+    doc["scenario"] = sc.to_json();
+    let out = PyDict::new(py);
+    out.set_item("document", json_text(&doc)?)?;
+    if let Some((names, rows, events)) = &found.orbit {
+        let width = names.len();
+        let table = Array2::from_shape_vec((rows.len(), width), rows.concat())
+            .map_err(|e| SquealError::new_err(e.to_string()))?;
+        out.set_item("orbit_columns", names.clone())?;
+        out.set_item("orbit", table.into_pyarray(py))?;
+        out.set_item("orbit_events", events.clone())?;
+    }
+    Ok(out)
+}
+
+/// A branch of limit cycles (`squeal branch --json`): the document as JSON
+/// text.
+#[pyfunction]
+fn branch(
+    py: Python<'_>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    param: (String, f64, f64, usize),
+) -> PyResult<String> {
+    let sc = resolve(kind, text, &sets)?;
+    let spec = format!("{}={}:{}:{}", param.0, param.1, param.2, param.3);
+    let (name, lo, hi, n) = squeal_study::branch::parse_range(&spec).map_err(input_err)?;
+    let values = squeal_study::branch::values(lo, hi, n);
+    squeal_study::branch::check(&sc, &name, &values).map_err(study_err)?;
+    let br = compute(py, |cancel| {
+        squeal_study::branch::follow(
+            &sc,
+            &name,
+            &values,
+            (lo, hi),
+            &squeal_study::NoProgress,
+            cancel,
+        )
+    })?;
+    json_text(&br.to_json(&name, &sc))
+}
+
 /// The compiled module.
 #[pymodule]
 fn _squeal(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -484,5 +553,7 @@ fn _squeal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(stability_map, m)?)?;
     m.add_function(wrap_pyfunction!(critical, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(cycle, m)?)?;
+    m.add_function(wrap_pyfunction!(branch, m)?)?;
     Ok(())
 }

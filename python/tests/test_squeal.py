@@ -244,3 +244,36 @@ def test_ctrl_c_interrupts_a_long_simulation_promptly():
                    "scenario checks or the first second of the run) is sometimes not seen", strict=False)
 def test_ctrl_c_soon_after_the_start():
     _interrupt_after(1.0)
+
+
+def test_cycle_equals_cli_json(cli):
+    doc = json.loads(cli("cycle", "disc-pad", "--json"))
+    c = squeal.cycle("disc-pad")
+    orbit = c.pop("orbit")
+    columns = c.pop("orbit_columns")
+    events = c.pop("orbit_events")
+    assert c == doc
+    # One period of the reversal cycle: the orbit closes on itself (the
+    # shooting residual bounds the mismatch) and spans the reported period.
+    assert orbit.dtype == np.float64 and orbit.shape == (len(events), len(columns))
+    assert columns[0] == "t"
+    assert orbit[-1, 0] - orbit[0, 0] == pytest.approx(c["period"], rel=1e-12)
+    assert c["multipliers"][0]["abs"] == pytest.approx(1.0, abs=1e-6)
+
+
+def test_branch_equals_cli_json(cli, tmp_path):
+    out = tmp_path / "b"
+    doc = json.loads(cli("branch", "belt", "--param", "V=0.2:0.4:3", "--out", str(out), "--json"))
+    b = squeal.branch("belt", param=("V", 0.2, 0.4, 3))
+    assert b == doc
+    # Every grid value is either on the branch or reported as failed.
+    grid = [p for p in b["points"] if p["point"] == "grid"]
+    assert len(grid) + len(b["failed"]) == 3
+    assert all(p["period"] > 0 for p in grid)
+
+
+def test_cycle_and_branch_bad_input_names_the_flag():
+    with pytest.raises(squeal.ScenarioError, match="settle-time"):
+        squeal.cycle("disc-pad", settle_time=-1.0)
+    with pytest.raises(squeal.ScenarioError, match="bogus"):
+        squeal.branch("disc-pad", param=("bogus", 0.5, 0.6, 3))

@@ -281,3 +281,25 @@ pub struct BranchPoint {
     /// The continuation run it belongs to.
     pub segment: usize,
 }
+
+/// Parse `NAME=LO:HI:N` (`squeal branch --param`): N evenly spaced
+/// values of NAME from LO to HI, LO < HI finite, 2 ≤ N ≤ 100 000.
+pub fn parse_range(spec: &str) -> Result<(String, f64, f64, usize), InputError> {
+    let bad = || {
+        InputError(format!(
+            "--param {spec}: expected NAME=LO:HI:N with numbers LO < HI and N ≥ 2"
+        ))
+    };
+    let (name, range) = spec.split_once('=').ok_or_else(bad)?;
+    let parts: Vec<&str> = range.split(':').collect();
+    if parts.len() != 3 {
+        return Err(bad());
+    }
+    let lo: f64 = parts[0].trim().parse().map_err(|_| bad())?;
+    let hi: f64 = parts[1].trim().parse().map_err(|_| bad())?;
+    let n: usize = parts[2].trim().parse().map_err(|_| bad())?;
+    if !(lo.is_finite() && hi.is_finite() && lo < hi && (2..=100_000).contains(&n)) {
+        return Err(bad());
+    }
+    Ok((name.trim().to_string(), lo, hi, n))
+}

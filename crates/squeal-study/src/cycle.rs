@@ -55,6 +55,44 @@ pub fn options(sc: &Scenario, settle_steps: u64, settle_time: f64) -> CycleOptio
     }
 }
 
+/// The options of `squeal cycle` after its checks (the CLI and the Python
+/// bindings call this one function): the settling budget (`settle_steps`
+/// returns, at most `settle_time` s simulated, agreement `settle_tol` in
+/// (0, 1)), an optional section `STATE[=LEVEL]`, a model that can be
+/// simulated, and a linearisation that is finite (named by parameter).
+pub fn checked_options(
+    sc: &Scenario,
+    settle_steps: u64,
+    settle_time: f64,
+    settle_tol: f64,
+    section: Option<&str>,
+) -> Result<CycleOptions, StudyError> {
+    if !(settle_time > 0.0 && settle_time.is_finite()) {
+        return Err(InputError(format!(
+            "--settle-time {settle_time}: must be a positive number of seconds"
+        ))
+        .into());
+    }
+    if !(settle_tol > 0.0 && settle_tol < 1.0) {
+        return Err(InputError(format!("--settle-tol {settle_tol}: must be in (0, 1)")).into());
+    }
+    if settle_steps == 0 {
+        return Err(InputError("--settle-steps 0: must be at least 1".into()).into());
+    }
+    sc.model.check_simulable().map_err(InputError)?;
+    // The validation path of a simulated run, the part that applies to a
+    // cycle (which budgets its own settling): a linearisation that overflows
+    // is named by parameter.
+    crate::feasible::scales(&sc.model, Some(sc))
+        .map_err(|e| crate::feasible::stability_failure(&sc.model, e))?;
+    let mut opts = options(sc, settle_steps, settle_time);
+    opts.settle_tol = settle_tol;
+    if let Some(spec) = section {
+        opts.section = Some(parse_section(spec, &sc.model.state_names())?);
+    }
+    Ok(opts)
+}
+
 /// Parse `--section STATE[=LEVEL]` against the model's state names.
 pub fn parse_section(spec: &str, names: &[String]) -> Result<Section, InputError> {
     let (name, level) = match spec.split_once('=') {

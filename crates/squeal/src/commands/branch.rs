@@ -10,8 +10,8 @@ use crate::ScenarioArgs;
 use clap::Args;
 use squeal_core::EventKind;
 use squeal_plot::{Format, Panel, Series};
-use squeal_study::branch::{check, follow, values, BranchPoint};
-use squeal_study::scenario::{InputError, Scenario};
+use squeal_study::branch::{check, follow, parse_range, values, BranchPoint};
+use squeal_study::scenario::Scenario;
 use squeal_study::NoProgress;
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
@@ -30,27 +30,6 @@ pub struct BranchArgs {
     /// Print the result as JSON on stdout.
     #[arg(long)]
     json: bool,
-}
-
-/// Parse `NAME=LO:HI:N`.
-fn parse_range(spec: &str) -> Result<(String, f64, f64, usize), InputError> {
-    let bad = || {
-        InputError(format!(
-            "--param {spec}: expected NAME=LO:HI:N with numbers LO < HI and N ≥ 2"
-        ))
-    };
-    let (name, range) = spec.split_once('=').ok_or_else(bad)?;
-    let parts: Vec<&str> = range.split(':').collect();
-    if parts.len() != 3 {
-        return Err(bad());
-    }
-    let lo: f64 = parts[0].trim().parse().map_err(|_| bad())?;
-    let hi: f64 = parts[1].trim().parse().map_err(|_| bad())?;
-    let n: usize = parts[2].trim().parse().map_err(|_| bad())?;
-    if !(lo.is_finite() && hi.is_finite() && lo < hi && (2..=100_000).contains(&n)) {
-        return Err(bad());
-    }
-    Ok((name.trim().to_string(), lo, hi, n))
 }
 
 /// Run the command.

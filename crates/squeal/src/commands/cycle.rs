@@ -10,8 +10,8 @@ use clap::Args;
 use squeal_core::cycle::CycleOptions;
 use squeal_core::EventKind;
 use squeal_plot::{Format, Labels, Panel, Series};
-use squeal_study::cycle::{of_scenario, options, parse_section, Found};
-use squeal_study::scenario::{InputError, Scenario};
+use squeal_study::cycle::{checked_options, of_scenario, Found};
+use squeal_study::scenario::Scenario;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
@@ -147,29 +147,13 @@ fn draw(found: &Found, sc: &Scenario, dir: &Path) -> Result<(), RunError> {
 /// Run the command.
 pub fn run(a: CycleArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
-    if !(a.settle_time > 0.0 && a.settle_time.is_finite()) {
-        return Err(InputError(format!(
-            "--settle-time {}: must be a positive number of seconds",
-            a.settle_time
-        ))
-        .into());
-    }
-    if !(a.settle_tol > 0.0 && a.settle_tol < 1.0) {
-        return Err(InputError(format!("--settle-tol {}: must be in (0, 1)", a.settle_tol)).into());
-    }
-    if a.settle_steps == 0 {
-        return Err(InputError("--settle-steps 0: must be at least 1".into()).into());
-    }
-    sc.model.check_simulable().map_err(InputError)?;
-    // i9's validation path, the part that applies to a cycle (which budgets
-    // its own settling): a linearisation that overflows is named by parameter.
-    squeal_study::feasible::scales(&sc.model, Some(&sc))
-        .map_err(|e| squeal_study::feasible::stability_failure(&sc.model, e))?;
-    let mut opts = options(&sc, a.settle_steps, a.settle_time);
-    opts.settle_tol = a.settle_tol;
-    if let Some(spec) = &a.section {
-        opts.section = Some(parse_section(spec, &sc.model.state_names())?);
-    }
+    let opts = checked_options(
+        &sc,
+        a.settle_steps,
+        a.settle_time,
+        a.settle_tol,
+        a.section.as_deref(),
+    )?;
     let stage = a.out.as_deref().map(Staging::new).transpose()?;
     let found = of_scenario(&sc, &opts, a.out.is_some(), &NEVER)?;
     let mut doc = found.to_json();
