@@ -3,8 +3,8 @@
 //! Every function here only converts types between Python/NumPy and
 //! [`squeal_study`], which computes exactly what the command line computes
 //! (the friendly classes live in `squeal/__init__.py`). Each computation runs
-//! on a worker thread with the GIL released ([`compute`]); the calling thread
-//! wakes every [`POLL`] to let Python handle signals, and on
+//! on a worker thread with the GIL released (`compute`); the calling thread
+//! wakes every `POLL` to let Python handle signals, and on
 //! `KeyboardInterrupt` sets the study's [`Cancel`] token, joins the worker
 //! and re-raises. No panic crosses into Python: a panicking worker becomes a
 //! `SquealError`.
