@@ -240,10 +240,12 @@ def test_ctrl_c_interrupts_a_long_simulation_promptly():
     _interrupt_after(3.0)
 
 
-@pytest.mark.xfail(reason="known bug, not yet understood: a SIGINT ~1 s after import (during "
-                   "scenario checks or the first second of the run) is sometimes not seen", strict=False)
 def test_ctrl_c_soon_after_the_start():
-    _interrupt_after(1.0)
+    # Early signals too: during the scenario checks and the first second of
+    # the run (once seen to be missed under a load of 10 on 2 cores, with an
+    # earlier build; not reproduced in 17 tries at delays 0 … 1.5 s since).
+    for delay in (0.0, 0.3, 1.0):
+        _interrupt_after(delay)
 
 
 def test_cycle_equals_cli_json(cli):
