@@ -482,25 +482,27 @@ impl Analysis {
     }
 }
 
+/// The SI prefixes squeal writes, largest first: (scale, prefix).
+pub const SI_PREFIXES: [(f64, &str); 9] = [
+    (1e9, "G"),
+    (1e6, "M"),
+    (1e3, "k"),
+    (1.0, ""),
+    (1e-3, "m"),
+    (1e-6, "µ"),
+    (1e-9, "n"),
+    (1e-12, "p"),
+    (1e-15, "f"),
+];
+
 /// `x` with an SI prefix and `digits` significant digits: `si(20751.3, "Hz", 4)`
 /// = "20.75 kHz", `si(3.2e-6, "m/s", 3)` = "3.20 µm/s".
 pub fn si(x: f64, unit: &str, digits: usize) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x} {unit}");
     }
-    const P: [(f64, &str); 9] = [
-        (1e9, "G"),
-        (1e6, "M"),
-        (1e3, "k"),
-        (1.0, ""),
-        (1e-3, "m"),
-        (1e-6, "µ"),
-        (1e-9, "n"),
-        (1e-12, "p"),
-        (1e-15, "f"),
-    ];
     let a = x.abs();
-    let (scale, prefix) = P
+    let (scale, prefix) = SI_PREFIXES
         .iter()
         .copied()
         .find(|(s, _)| a >= *s * 0.999_95)

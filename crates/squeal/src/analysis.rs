@@ -100,21 +100,11 @@ impl PlotSettings {
 /// A prefix scale for values up to `max_abs`: (divisor, prefix) such that the
 /// scaled values lie in [1, 1000) — "µ" for 3e-6.
 pub fn si_scale(max_abs: f64) -> (f64, &'static str) {
-    const P: [(f64, &str); 9] = [
-        (1e9, "G"),
-        (1e6, "M"),
-        (1e3, "k"),
-        (1.0, ""),
-        (1e-3, "m"),
-        (1e-6, "µ"),
-        (1e-9, "n"),
-        (1e-12, "p"),
-        (1e-15, "f"),
-    ];
     if !(max_abs.is_finite() && max_abs > 0.0) {
         return (1.0, "");
     }
-    P.iter()
+    squeal_study::analysis::SI_PREFIXES
+        .iter()
         .copied()
         .find(|(s, _)| max_abs >= *s)
         .unwrap_or((1e-15, "f"))
