@@ -972,3 +972,293 @@ pub fn conclusions(rs: &[SetResult], sw: &Sweeps) -> Vec<Conclusion> {
     });
     out
 }
+
+/// The 40 sets as `reproduce` runs them: [`crate::scenario::thesis_sets`]
+/// with every duration multiplied by `duration_scale` (in (0, 10]) and
+/// each checked by [`crate::feasible::prepare`]. An unsharded run, every
+/// shard and the merge all start from this, so they run the same scenarios.
+pub fn prepared_sets(duration_scale: f64) -> Result<Vec<Scenario>, StudyError> {
+    if !(duration_scale.is_finite() && duration_scale > 0.0 && duration_scale <= 10.0) {
+        return Err(crate::scenario::InputError(format!(
+            "--duration-scale {duration_scale}: must be in (0, 10]"
+        ))
+        .into());
+    }
+    let mut sets = crate::scenario::thesis_sets();
+    for s in &mut sets {
+        let d = s.duration * duration_scale;
+        s.apply("duration", &crate::scenario::Setting::Number(d))?;
+        crate::feasible::prepare(s)?;
+    }
+    Ok(sets)
+}
+
+/// Shards of `reproduce`: a [`SetResult`] written as JSON and read back bit
+/// for bit. Every `f64` is the text `{:e}` (the shortest decimal that
+/// parses back to the same bits, `NaN` and `inf` included), never a JSON
+/// number, so a merged report is the unsharded one byte for byte. The
+/// scenario is not written: the merge rebuilds it with [`prepared_sets`].
+pub mod exact {
+    use super::{Linear, SetResult, SquealAnswer};
+    use crate::scenario::Scenario;
+    use crate::study::StickStats;
+    use serde_json::{json, Value};
+
+    fn x(v: f64) -> Value {
+        Value::String(format!("{v:e}"))
+    }
+    fn ox(v: Option<f64>) -> Value {
+        v.map_or(Value::Null, x)
+    }
+
+    /// One set's result as JSON (see the module docs).
+    pub fn to_json(r: &SetResult) -> Value {
+        json!({
+            "id": r.id,
+            "linear": r.linear.as_ref().map_or(Value::Null, |l| json!({
+                "max_growth": x(l.max_growth),
+                "freq_hz": x(l.freq_hz),
+                "growing": l.growing,
+                "neutral": l.neutral,
+                "modes": l.modes.iter().map(|(s, w, d)| json!([x(*s), x(*w), d])).collect::<Vec<_>>(),
+            })),
+            "linear_note": r.linear_note,
+            "verdict": r.verdict,
+            "f_t": ox(r.f_t),
+            "f_n": ox(r.f_n),
+            "growth": r.growth.iter().map(|(n, g)| json!([n, x(*g)])).collect::<Vec<_>>(),
+            "stick_fraction": x(r.stick_fraction),
+            "events": r.events,
+            "first_reversal": ox(r.first_reversal),
+            "vxd_peak": x(r.vxd_peak),
+            "vxd_tail_peak": x(r.vxd_tail_peak),
+            "vxp_max": x(r.vxp_max),
+            "tangential_zero": r.tangential_zero,
+            "tan_prom_at_fn": ox(r.tan_prom_at_fn),
+            "nor_prom_at_ft": ox(r.nor_prom_at_ft),
+            "stick": {
+                "sticks": r.stick.sticks,
+                "reversals": r.stick.reversals,
+                "durations": r.stick.durations.map_or(Value::Null, |(a, b, c)| json!([x(a), x(b), x(c)])),
+            },
+            "free_fraction": x(r.free_fraction),
+            "squeal": r.squeal.as_ref().map_or(Value::Null, |s| json!({
+                "coordinate": s.coordinate,
+                "frequency_hz": x(s.frequency_hz),
+                "level_db": x(s.level_db),
+            })),
+            "normal_power": r.normal_power.map_or(Value::Null, |(a, b)| json!([x(a), x(b)])),
+            "normal_rate": ox(r.normal_rate),
+        })
+    }
+
+    fn gx(v: &Value, what: &str) -> Result<f64, String> {
+        v.as_str()
+            .and_then(|s| s.parse::<f64>().ok())
+            .ok_or_else(|| format!("{what}: not a number"))
+    }
+    fn gox(v: &Value, what: &str) -> Result<Option<f64>, String> {
+        if v.is_null() {
+            Ok(None)
+        } else {
+            gx(v, what).map(Some)
+        }
+    }
+    fn gs(v: &Value, what: &str) -> Result<String, String> {
+        v.as_str()
+            .map(str::to_string)
+            .ok_or_else(|| format!("{what}: not text"))
+    }
+    fn gb(v: &Value, what: &str) -> Result<bool, String> {
+        v.as_bool().ok_or_else(|| format!("{what}: not true/false"))
+    }
+    fn gu(v: &Value, what: &str) -> Result<u64, String> {
+        v.as_u64()
+            .ok_or_else(|| format!("{what}: not a whole number"))
+    }
+    fn arr<'a>(v: &'a Value, what: &str) -> Result<&'a Vec<Value>, String> {
+        v.as_array().ok_or_else(|| format!("{what}: not a list"))
+    }
+
+    /// Read back what [`to_json`] wrote, for the scenario `sc` it was
+    /// measured on; the error names the field.
+    pub fn from_json(v: &Value, sc: Scenario) -> Result<SetResult, String> {
+        let id = gu(&v["id"], "id")? as usize;
+        let linear = match &v["linear"] {
+            Value::Null => None,
+            l => Some(Linear {
+                max_growth: gx(&l["max_growth"], "linear.max_growth")?,
+                freq_hz: gx(&l["freq_hz"], "linear.freq_hz")?,
+                growing: gb(&l["growing"], "linear.growing")?,
+                neutral: gb(&l["neutral"], "linear.neutral")?,
+                modes: arr(&l["modes"], "linear.modes")?
+                    .iter()
+                    .map(|m| {
+                        Ok((
+                            gx(&m[0], "linear.modes")?,
+                            gx(&m[1], "linear.modes")?,
+                            gs(&m[2], "linear.modes")?,
+                        ))
+                    })
+                    .collect::<Result<_, String>>()?,
+            }),
+        };
+        let ev = arr(&v["events"], "events")?;
+        let mut events = [0u64; 5];
+        if ev.len() != events.len() {
+            return Err("events: expected 5 counts".into());
+        }
+        for (e, j) in events.iter_mut().zip(ev) {
+            *e = gu(j, "events")?;
+        }
+        let st = &v["stick"];
+        let durations = match &st["durations"] {
+            Value::Null => None,
+            d => Some((
+                gx(&d[0], "stick.durations")?,
+                gx(&d[1], "stick.durations")?,
+                gx(&d[2], "stick.durations")?,
+            )),
+        };
+        Ok(SetResult {
+            id,
+            linear,
+            linear_note: gs(&v["linear_note"], "linear_note")?,
+            verdict: gs(&v["verdict"], "verdict")?,
+            f_t: gox(&v["f_t"], "f_t")?,
+            f_n: gox(&v["f_n"], "f_n")?,
+            growth: arr(&v["growth"], "growth")?
+                .iter()
+                .map(|g| Ok((gs(&g[0], "growth")?, gx(&g[1], "growth")?)))
+                .collect::<Result<_, String>>()?,
+            stick_fraction: gx(&v["stick_fraction"], "stick_fraction")?,
+            events,
+            first_reversal: gox(&v["first_reversal"], "first_reversal")?,
+            vxd_peak: gx(&v["vxd_peak"], "vxd_peak")?,
+            vxd_tail_peak: gx(&v["vxd_tail_peak"], "vxd_tail_peak")?,
+            vxp_max: gx(&v["vxp_max"], "vxp_max")?,
+            tangential_zero: gb(&v["tangential_zero"], "tangential_zero")?,
+            tan_prom_at_fn: gox(&v["tan_prom_at_fn"], "tan_prom_at_fn")?,
+            nor_prom_at_ft: gox(&v["nor_prom_at_ft"], "nor_prom_at_ft")?,
+            stick: StickStats {
+                sticks: gu(&st["sticks"], "stick.sticks")?,
+                reversals: gu(&st["reversals"], "stick.reversals")?,
+                durations,
+            },
+            free_fraction: gx(&v["free_fraction"], "free_fraction")?,
+            squeal: match &v["squeal"] {
+                Value::Null => None,
+                s => Some(SquealAnswer {
+                    coordinate: gs(&s["coordinate"], "squeal.coordinate")?,
+                    frequency_hz: gx(&s["frequency_hz"], "squeal.frequency_hz")?,
+                    level_db: gx(&s["level_db"], "squeal.level_db")?,
+                }),
+            },
+            normal_power: match &v["normal_power"] {
+                Value::Null => None,
+                p => Some((gx(&p[0], "normal_power")?, gx(&p[1], "normal_power")?)),
+            },
+            normal_rate: gox(&v["normal_rate"], "normal_rate")?,
+            sc,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bits of every f64 in a result's Debug text agree when the texts do
+    /// (Debug prints the shortest round-trip decimal).
+    fn same(a: &SetResult, b: &SetResult) -> bool {
+        format!("{a:?}") == format!("{b:?}")
+    }
+
+    #[test]
+    fn a_measured_set_round_trips_bit_for_bit() {
+        // Set 1 (no steady sliding) and set 15 (sliding, with modes), short runs.
+        let sets = prepared_sets(0.02).unwrap();
+        for i in [0usize, 14, 36] {
+            let r = measure(i + 1, sets[i].clone(), &Cancel::new(), |_, _| {
+                Ok::<(), StudyError>(())
+            })
+            .unwrap();
+            let text = serde_json::to_string(&exact::to_json(&r)).unwrap();
+            let back: Value = serde_json::from_str(&text).unwrap();
+            let b = exact::from_json(&back, sets[i].clone()).unwrap();
+            assert!(same(&r, &b), "set {}:\n{r:?}\n{b:?}", i + 1);
+        }
+    }
+
+    #[test]
+    fn awkward_values_round_trip_and_bad_fields_are_named() {
+        let sc = prepared_sets(0.02).unwrap().remove(0);
+        let r = SetResult {
+            id: 1,
+            sc: sc.clone(),
+            linear: Some(Linear {
+                max_growth: -0.0,
+                freq_hz: 1.0 / 3.0,
+                growing: false,
+                neutral: true,
+                modes: vec![(f64::MIN_POSITIVE / 4.0, f64::INFINITY, "x_d".into())],
+            }),
+            linear_note: "n\"ote".into(),
+            verdict: "decays".into(),
+            f_t: None,
+            f_n: Some(f64::NEG_INFINITY),
+            growth: vec![("vx_d".into(), 6.02e23)],
+            stick_fraction: 0.1 + 0.2,
+            events: [1, 2, 3, 4, u64::MAX],
+            first_reversal: Some(1e-300),
+            vxd_peak: f64::MAX,
+            vxd_tail_peak: 0.0,
+            vxp_max: 5e-324,
+            tangential_zero: true,
+            tan_prom_at_fn: None,
+            nor_prom_at_ft: Some(-1.5),
+            stick: StickStats {
+                sticks: 3,
+                reversals: 0,
+                durations: Some((0.1, 0.2, 0.3)),
+            },
+            free_fraction: 1.0 - 1e-16,
+            squeal: Some(SquealAnswer {
+                coordinate: "vx_p".into(),
+                frequency_hz: 1234.5678901234,
+                level_db: -3.0,
+            }),
+            normal_power: Some((7.0, 8.0)),
+            normal_rate: None,
+        };
+        let j = exact::to_json(&r);
+        let b = exact::from_json(&j, sc.clone()).unwrap();
+        assert!(same(&r, &b), "{r:?}\n{b:?}");
+        assert_eq!(b.linear.unwrap().max_growth.to_bits(), (-0.0f64).to_bits());
+        let mut bad = j.clone();
+        bad["vxp_max"] = json!("x");
+        assert_eq!(
+            exact::from_json(&bad, sc.clone()).unwrap_err(),
+            "vxp_max: not a number"
+        );
+        bad = j;
+        bad["events"] = json!([1, 2]);
+        assert!(exact::from_json(&bad, sc)
+            .unwrap_err()
+            .starts_with("events"));
+    }
+
+    #[test]
+    fn duration_scale_is_checked() {
+        for bad in [0.0, -1.0, 10.5, f64::NAN] {
+            let e = prepared_sets(bad).unwrap_err().to_string();
+            assert!(e.starts_with("--duration-scale"), "{e}");
+        }
+        let a = prepared_sets(0.5).unwrap();
+        let b = crate::scenario::thesis_sets();
+        assert_eq!(a.len(), 40);
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!(x.duration, y.duration * 0.5);
+        }
+    }
+}

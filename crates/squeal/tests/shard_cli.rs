@@ -321,3 +321,303 @@ fn a_shard_with_json_prints_json_only() {
             .unwrap();
     assert_eq!((m["k"].as_u64(), m["n"].as_u64()), (Some(2), Some(7)));
 }
+
+/// A transient map whose stiffest row really fails: at c = 1e10 kg/s the
+/// belt's overdamped mode has |λ| = c/m = 1e10 1/s, and 0.05 s would need
+/// at least 0.05·1e10/6.5 ≈ 7.7e7 explicit steps (limit 1e7), so those
+/// runs are refused as too stiff; the other rows run.
+const FAILING: [&str; 10] = [
+    "map",
+    "belt",
+    "--x",
+    "V=2:16:3",
+    "--y",
+    "c=1:1e10:3",
+    "--log-y",
+    "--transient",
+    "--duration",
+    "0.05",
+];
+
+#[test]
+fn failed_points_are_merged_as_failed_and_reported() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    // The failure is real: the same run alone is refused as too stiff.
+    let one = squeal_raw(
+        dir,
+        &[
+            "simulate",
+            "belt",
+            "--set",
+            "c=1e10",
+            "--set",
+            "V=2",
+            "--duration",
+            "0.05",
+            "--out",
+            "one",
+        ],
+    );
+    let err = String::from_utf8_lossy(&one.stderr);
+    assert_eq!(one.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("too stiff") && err.contains("set by c = 1e10"),
+        "{err}"
+    );
+    squeal(dir, &with(&FAILING, &["--out", "full"]));
+    let csv = std::fs::read_to_string(dir.join("full/map.csv")).unwrap();
+    // Rows y-major: points 6, 7, 8 are c = 1e10, and only they failed.
+    for (i, line) in csv.lines().skip(1).enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        assert_eq!(f[4] == "failed", i >= 6, "{line}");
+        if i >= 6 {
+            assert_eq!(&f[5..], ["nan", "nan", "nan", "n/a"], "{line}");
+        }
+    }
+    for n in [2usize, 3] {
+        let mut args: Vec<String> = vec!["merge".into()];
+        for k in 0..n {
+            let out = format!("f{n}-{k}");
+            squeal(
+                dir,
+                &with(&FAILING, &["--shard", &format!("{k}/{n}"), "--out", &out]),
+            );
+            args.push(out);
+        }
+        let m = format!("m{n}");
+        args.extend(["--out".into(), m.clone()]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = squeal(dir, &args);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            text.contains(&format!(
+                "merged 9 points from {n} shards; 3 failed points (recorded as failed in map.csv): 6, 7, 8"
+            )),
+            "{text}"
+        );
+        for f in [
+            "map.csv",
+            "map.png",
+            "map.svg",
+            "transient.png",
+            "transient.svg",
+        ] {
+            let a = std::fs::read(dir.join("full").join(f)).unwrap();
+            let b = std::fs::read(dir.join(&m).join(f)).unwrap();
+            assert!(a == b, "{f} differs after merging {n} shards");
+        }
+    }
+}
+
+/// `reproduce` at a fiftieth of the shipped durations.
+const REPRODUCE: [&str; 3] = ["reproduce", "--duration-scale", "0.02"];
+
+/// Every file under `root`, relative, sorted.
+fn files_under(root: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    let mut todo = vec![root.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                todo.push(p);
+            } else {
+                out.push(p.strip_prefix(root).unwrap().to_path_buf());
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The same files, byte for byte, in both folders.
+fn same_tree(a: &Path, b: &Path) {
+    let (fa, fb) = (files_under(a), files_under(b));
+    assert_eq!(fa, fb, "different files");
+    for f in fa {
+        assert!(
+            std::fs::read(a.join(&f)).unwrap() == std::fs::read(b.join(&f)).unwrap(),
+            "{} differs",
+            f.display()
+        );
+    }
+}
+
+fn reproduce_shards(dir: &Path, base: &[&str], n: usize, prefix: &str) -> Vec<String> {
+    (0..n)
+        .map(|k| {
+            let out = format!("{prefix}{k}");
+            squeal(
+                dir,
+                &with(base, &["--shard", &format!("{k}/{n}"), "--out", &out]),
+            );
+            out
+        })
+        .collect()
+}
+
+#[test]
+fn reproduce_shards_merge_byte_identical() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let base = with(&REPRODUCE, &["--no-figures"]);
+    squeal(dir, &with(&base, &["--out", "full"]));
+    // What squeal owns (its manifest) and the report; same_tree compares all.
+    let files: Vec<std::path::PathBuf> = [
+        ".squeal-manifest.json",
+        "conclusions.json",
+        "map.png",
+        "map.svg",
+        "report.html",
+        "report.md",
+        "table.csv",
+    ]
+    .iter()
+    .map(std::path::PathBuf::from)
+    .collect();
+    assert_eq!(files_under(&dir.join("full")), files);
+    // 40 sets in 3 shards: 14 / 13 / 13.
+    for n in [1usize, 3] {
+        let mut dirs = reproduce_shards(dir, &base, n, &format!("r{n}-"));
+        dirs.reverse();
+        let m = format!("m{n}");
+        let mut args: Vec<&str> = vec!["merge"];
+        args.extend(dirs.iter().map(String::as_str));
+        args.extend(["--out", &m]);
+        let out = squeal(dir, &args);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            text.contains(&format!("merged 40 sets from {n} shards: ")),
+            "{text}"
+        );
+        same_tree(&dir.join("full"), &dir.join(&m));
+    }
+    let man: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("r3-1/shard.json")).unwrap())
+            .unwrap();
+    assert_eq!(man["study"]["command"], "reproduce");
+    assert_eq!(man["points"], 13, "sets 2, 5, … 38");
+}
+
+#[test]
+fn reproduce_shards_with_figures_merge_byte_identical() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    squeal(dir, &with(&REPRODUCE, &["--out", "full"]));
+    assert!(dir.join("full/figures/set40").is_dir());
+    let dirs = reproduce_shards(dir, &REPRODUCE, 2, "r");
+    squeal(dir, &["merge", &dirs[0], &dirs[1], "--out", "merged"]);
+    same_tree(&dir.join("full"), &dir.join("merged"));
+    std::fs::remove_dir_all(dir.join("merged")).unwrap();
+    // A picture cut short is found.
+    let shard = dir.join("r1/figures/set02");
+    let pic = std::fs::read_dir(&shard)
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    let bytes = std::fs::read(&pic).unwrap();
+    std::fs::write(&pic, &bytes[..bytes.len() / 2]).unwrap();
+    let name = pic.file_name().unwrap().to_string_lossy().to_string();
+    refused(
+        dir,
+        &["merge", "r0", "r1", "--out", "merged"],
+        &format!("r1: figures/set02/{name} is truncated or changed"),
+    );
+}
+
+#[test]
+fn merge_refuses_bad_reproduce_shards() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let base = with(&REPRODUCE, &["--no-figures"]);
+    reproduce_shards(dir, &base, 3, "a");
+    let m = ["--out", "merged"];
+    refused(
+        dir,
+        &with(&["merge", "a0", "a2"], &m),
+        "missing shard 1/3 (sets 2, 5, 8, 11, 14, 17, 20, 23, 26, 29, 32, 35 … (13 in all))",
+    );
+    refused(
+        dir,
+        &with(&["merge", "a0", "a1", "a2", "a0"], &m),
+        "shard 0/3 given twice",
+    );
+    // Another duration scale, with figures, a map's shard.
+    squeal(
+        dir,
+        &[
+            "reproduce",
+            "--duration-scale",
+            "0.03",
+            "--no-figures",
+            "--shard",
+            "1/3",
+            "--out",
+            "b1",
+        ],
+    );
+    refused(
+        dir,
+        &with(&["merge", "a0", "b1", "a2"], &m),
+        "different --duration-scale",
+    );
+    squeal(dir, &with(&REPRODUCE, &["--shard", "1/3", "--out", "c1"]));
+    refused(
+        dir,
+        &with(&["merge", "a0", "c1", "a2"], &m),
+        "one draws figures, the other has --no-figures",
+    );
+    squeal(dir, &with(&LINEAR, &["--shard", "1/3", "--out", "g1"]));
+    refused(
+        dir,
+        &with(&["merge", "a0", "g1", "a2"], &m),
+        "different commands (\"reproduce\" and \"map\")",
+    );
+    // Truncated results.
+    let part = dir.join("a1/part.json");
+    let text = std::fs::read_to_string(&part).unwrap();
+    std::fs::write(&part, &text[..text.len() - 30]).unwrap();
+    refused(
+        dir,
+        &with(&["merge", "a0", "a1", "a2"], &m),
+        "a1: part.json is truncated or changed",
+    );
+    // Recomputed alone, the shard repairs the study.
+    squeal(dir, &with(&base, &["--shard", "1/3", "--out", "a1"]));
+    squeal(dir, &with(&["merge", "a0", "a1", "a2"], &m));
+}
+
+#[test]
+fn slurm_reproduce_scripts_run_as_an_array_and_merge() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    let base = with(&REPRODUCE, &["--no-figures"]);
+    squeal(dir, &with(&base, &["--out", "full"]));
+    let mut args = vec!["slurm"];
+    args.extend(&base);
+    args.extend(["--tasks", "2", "--out", "merged"]);
+    squeal(dir, &args);
+    let array = std::fs::read_to_string(dir.join("merged-slurm/array.sh")).unwrap();
+    assert!(array.lines().any(|l| l == "#SBATCH --array=0-1"), "{array}");
+    assert!(
+        array.contains("reproduce --duration-scale 0.02 --no-figures --shard \"$K/2\""),
+        "{array}"
+    );
+    let bash = |script: &str, task: Option<usize>| {
+        let mut c = Command::new("bash");
+        c.current_dir(dir)
+            .arg(dir.join("merged-slurm").join(script));
+        if let Some(k) = task {
+            c.env("SLURM_ARRAY_TASK_ID", k.to_string());
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    bash("array.sh", Some(0));
+    bash("array.sh", Some(1));
+    bash("merge.sh", None);
+    same_tree(&dir.join("full"), &dir.join("merged"));
+}

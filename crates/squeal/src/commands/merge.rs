@@ -1,4 +1,4 @@
-//! Shards of a map and `squeal merge DIR… --out DIR`.
+//! Shards of a map or of `reproduce`, and `squeal merge DIR… --out DIR`.
 //!
 //! `squeal map … --shard K/N` computes the points whose flat index `i`
 //! (row-major over y then x, see [`squeal_study::map::point`]) has
@@ -19,6 +19,19 @@
 //! (truncated, edited); then it writes `map.csv` and the pictures through
 //! [`crate::commands::map::write_map`], the writer of the unsharded map, so
 //! the result is byte-identical to it.
+//!
+//! `squeal reproduce … --shard K/N` measures the thesis sets whose index
+//! `i` (set `i + 1`) has `i mod N = K` and writes `shard.json`, `part.json`
+//! (each set's results, every number as exact text, see
+//! [`squeal_study::reproduce::exact`]) and, unless `--no-figures`, the sets'
+//! Appendix A pictures under `figures/` (each listed in the manifest with
+//! its length and hash). `merge` recognises such shards by their manifest's
+//! `study.command`, refuses them for the same reasons as map shards (a
+//! missing shard names its sets), rebuilds the 40 scenarios with
+//! [`squeal_study::reproduce::prepared_sets`] (and refuses shards made from
+//! other sets), copies the pictures and ends through
+//! [`crate::commands::reproduce::finish`] — the same sweeps, conclusions,
+//! map and report as the unsharded `reproduce`, byte for byte.
 
 use crate::commands::map::{report, write_map, write_rows, Labels};
 use crate::run::{RunError, Staging};
@@ -33,6 +46,8 @@ use std::path::{Path, PathBuf};
 pub const SHARD_FILE: &str = "shard.json";
 /// A shard's rows.
 pub const PART_FILE: &str = "part.csv";
+/// A `reproduce` shard's sets.
+pub const SETS_FILE: &str = "part.json";
 /// The `format` of [`SHARD_FILE`].
 const FORMAT: &str = "squeal-shard-1";
 
@@ -105,6 +120,90 @@ pub fn study_json(sc: &Scenario, labels: &Labels, x: &Axis, y: &Axis, transient:
     })
 }
 
+/// The study a `reproduce` shard belongs to: the squeal version, the
+/// duration scale, whether it draws figures, and a hash of the 40 prepared
+/// scenarios (their resolved content).
+pub fn reproduce_study(sets: &[Scenario], duration_scale: f64, figures: bool) -> Value {
+    let content: Vec<Value> = sets.iter().map(Scenario::to_json).collect();
+    let text = serde_json::to_string(&content).unwrap_or_default();
+    json!({
+        "command": "reproduce",
+        "squeal_version": env!("CARGO_PKG_VERSION"),
+        "duration_scale": format!("{duration_scale:e}"),
+        "figures": figures,
+        "sets": { "count": sets.len(), "hash": fnv1a(text.as_bytes()) },
+    })
+}
+
+fn write_file(path: &Path, bytes: &[u8]) -> Result<(), RunError> {
+    std::fs::write(path, bytes)
+        .map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))
+}
+
+/// Every file under `dir/figures`, as paths relative to `dir` with `/`,
+/// sorted.
+fn figure_files(dir: &Path) -> Result<Vec<String>, RunError> {
+    let mut out = Vec::new();
+    let mut todo = vec![dir.join("figures")];
+    while let Some(d) = todo.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries {
+            let e = e.map_err(|e| RunError::Io(format!("cannot read {}: {e}", d.display())))?;
+            let p = e.path();
+            if p.is_dir() {
+                todo.push(p);
+            } else if let Ok(rel) = p.strip_prefix(dir) {
+                let parts: Vec<String> = rel
+                    .components()
+                    .map(|c| c.as_os_str().to_string_lossy().into_owned())
+                    .collect();
+                out.push(parts.join("/"));
+            }
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Write a `reproduce` shard (`part.json`, then `shard.json` listing
+/// `part.json` and every picture under `figures/` with its length and
+/// hash) into `stage`, whose `figures/` the sets have drawn into.
+pub fn write_reproduce_part(
+    stage: &Staging,
+    study: &Value,
+    s: Shard,
+    rs: &[squeal_study::reproduce::SetResult],
+) -> Result<(), RunError> {
+    let sets: Vec<Value> = rs
+        .iter()
+        .map(squeal_study::reproduce::exact::to_json)
+        .collect();
+    let bytes =
+        serde_json::to_string_pretty(&sets).map_err(|e| RunError::Io(e.to_string()))? + "\n";
+    write_file(&stage.path(SETS_FILE), bytes.as_bytes())?;
+    let mut figures = Vec::new();
+    for f in figure_files(stage.dir())? {
+        let p = stage.dir().join(&f);
+        let b = std::fs::read(&p)
+            .map_err(|e| RunError::Io(format!("cannot read {}: {e}", p.display())))?;
+        figures.push(json!({ "file": f, "bytes": b.len(), "fnv1a": fnv1a(&b) }));
+    }
+    let doc = json!({
+        "format": FORMAT,
+        "study": study,
+        "k": s.k,
+        "n": s.n,
+        "slicing": "interleaved: set index i (set i + 1) belongs to shard i mod n",
+        "points": rs.len(),
+        "part": { "file": SETS_FILE, "rows": rs.len(), "bytes": bytes.len(), "fnv1a": fnv1a(bytes.as_bytes()) },
+        "figures": figures,
+    });
+    let text = serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?;
+    write_file(&stage.path(SHARD_FILE), (text + "\n").as_bytes())
+}
+
 /// Write a shard (`part.csv` then `shard.json`) into `stage`.
 #[allow(clippy::too_many_arguments)]
 pub fn write_part(
@@ -141,10 +240,10 @@ pub fn write_part(
 /// Arguments of `squeal merge`.
 #[derive(Args, Debug)]
 pub struct MergeArgs {
-    /// The shard folders (`squeal map … --shard K/N --out DIR`), all N of them.
+    /// The shard folders (`squeal map|reproduce … --shard K/N --out DIR`), all N of them.
     #[arg(required = true, value_name = "DIR")]
     shards: Vec<PathBuf>,
-    /// Output folder for the merged map.
+    /// Output folder for the merged map or report.
     #[arg(long)]
     out: PathBuf,
     /// Print a JSON summary on stdout.
@@ -204,8 +303,26 @@ fn difference(a: &Value, b: &Value) -> Option<String> {
     if a["squeal_version"] != b["squeal_version"] {
         return Some(format!("made by squeal {} and {}", v(a), v(b)));
     }
-    if a["command"] != b["command"] || a["transient"] != b["transient"] {
+    if a["command"] != b["command"] {
+        return Some(format!(
+            "different commands ({} and {})",
+            a["command"], b["command"]
+        ));
+    }
+    if a["transient"] != b["transient"] {
         return Some("different kinds of map (linear and --transient)".into());
+    }
+    if a["duration_scale"] != b["duration_scale"] {
+        return Some(format!(
+            "different --duration-scale ({} and {})",
+            a["duration_scale"], b["duration_scale"]
+        ));
+    }
+    if a["figures"] != b["figures"] {
+        return Some("one draws figures, the other has --no-figures".into());
+    }
+    if a["sets"] != b["sets"] {
+        return Some("different thesis sets".into());
     }
     let h = |s: &Value| {
         format!(
@@ -368,10 +485,16 @@ pub fn run(a: MergeArgs) -> Result<(), RunError> {
         }
         by_k[r.k] = Some(r);
     }
-    let bad_grid = |e: String| refuse(format!("{}: {SHARD_FILE}: {e}", first.dir.display()));
-    let x = axis_of(&study["grid"]["x"]).map_err(bad_grid)?;
-    let y = axis_of(&study["grid"]["y"]).map_err(bad_grid)?;
-    let total = x.values.len() * y.values.len();
+    let reproduce = study["command"] == "reproduce";
+    let (total, x, y) = if reproduce {
+        let count = study["sets"]["count"].as_u64().unwrap_or(0) as usize;
+        (count, None, None)
+    } else {
+        let bad_grid = |e: String| refuse(format!("{}: {SHARD_FILE}: {e}", first.dir.display()));
+        let x = axis_of(&study["grid"]["x"]).map_err(bad_grid)?;
+        let y = axis_of(&study["grid"]["y"]).map_err(bad_grid)?;
+        (x.values.len() * y.values.len(), Some(x), Some(y))
+    };
     let missing: Vec<usize> = (0..n).filter(|k| by_k[*k].is_none()).collect();
     if !missing.is_empty() {
         let ks: Vec<String> = missing.iter().map(|k| format!("{k}/{n}")).collect();
@@ -380,16 +503,26 @@ pub fn run(a: MergeArgs) -> Result<(), RunError> {
             .flat_map(|&k| Shard { k, n }.points(total))
             .collect();
         points.sort_unstable();
+        // Sets are numbered from 1.
+        let (what, first_no, cmd) = if reproduce {
+            ("sets", 1, "reproduce")
+        } else {
+            ("points", 0, "map")
+        };
+        let named: Vec<usize> = points.iter().map(|p| p + first_no).collect();
         return Err(refuse(format!(
-            "missing shard {} (points {}): recompute with `squeal map … --shard K/N`",
+            "missing shard {} ({what} {}): recompute with `squeal {cmd} … --shard K/N`",
             ks.join(", "),
-            if points.is_empty() {
+            if named.is_empty() {
                 "none".into()
             } else {
-                some(&points)
+                some(&named)
             }
         )));
     }
+    let (Some(x), Some(y)) = (x, y) else {
+        return merge_reproduce(&shards, n, &a.out, a.json);
+    };
     let mut lin = vec![(f64::NAN, f64::NAN); total];
     let mut trans = (study["transient"] == true).then(|| vec![Outcome::FAILED; total]);
     for r in &shards {
@@ -435,6 +568,156 @@ pub fn run(a: MergeArgs) -> Result<(), RunError> {
         &dest,
         a.json,
     )
+}
+
+/// A file of a shard, read and checked against the length and hash its
+/// manifest gives.
+fn checked_file(r: &Read, file: &str, entry: &Value) -> Result<Vec<u8>, RunError> {
+    let d = r.dir.display();
+    let safe = !file.is_empty()
+        && !file.starts_with('/')
+        && file
+            .split('/')
+            .all(|c| !c.is_empty() && c != "." && c != "..");
+    if !safe {
+        return Err(refuse(format!(
+            "{d}: {SHARD_FILE} names a file outside the shard: {file:?}"
+        )));
+    }
+    let bytes = std::fs::read(r.dir.join(file))
+        .map_err(|e| refuse(format!("{d}: not a complete shard ({file}: {e})")))?;
+    if entry["bytes"].as_u64() != Some(bytes.len() as u64)
+        || entry["fnv1a"].as_str() != Some(fnv1a(&bytes).as_str())
+    {
+        return Err(refuse(format!(
+            "{d}: {file} is truncated or changed ({} bytes, the manifest says {}); recompute this shard",
+            bytes.len(),
+            entry["bytes"]
+        )));
+    }
+    Ok(bytes)
+}
+
+/// Merge `reproduce` shards (already checked to be one whole study) into
+/// the report of the unsharded `reproduce`.
+fn merge_reproduce(shards: &[Read], n: usize, out: &Path, json: bool) -> Result<(), RunError> {
+    use squeal_study::reproduce::{exact, prepared_sets, SetResult};
+    let first = &shards[0];
+    let study = &first.doc["study"];
+    let scale = study["duration_scale"]
+        .as_str()
+        .and_then(|s| s.parse::<f64>().ok())
+        .ok_or_else(|| {
+            refuse(format!(
+                "{}: {SHARD_FILE} lacks its duration scale",
+                first.dir.display()
+            ))
+        })?;
+    let figures = study["figures"].as_bool().unwrap_or(false);
+    let sets = prepared_sets(scale)
+        .map_err(|e| refuse(format!("{}: {SHARD_FILE}: {e}", first.dir.display())))?;
+    if reproduce_study(&sets, scale, figures) != *study {
+        return Err(refuse(format!(
+            "{}: made from other thesis sets than this squeal's (scenarios changed); recompute the shards",
+            first.dir.display()
+        )));
+    }
+    let mut rs: Vec<Option<SetResult>> = vec![None; sets.len()];
+    let mut pictures: Vec<(String, Vec<u8>)> = Vec::new();
+    for r in shards {
+        let d = r.dir.display();
+        let want = Shard { k: r.k, n: r.n }.points(sets.len());
+        let part = &r.doc["part"];
+        if part["rows"].as_u64() != Some(want.len() as u64)
+            || r.doc["points"].as_u64() != Some(want.len() as u64)
+        {
+            return Err(refuse(format!(
+                "{d}: shard {}/{} of {} sets should hold {} sets, its manifest says {}",
+                r.k,
+                r.n,
+                sets.len(),
+                want.len(),
+                part["rows"]
+            )));
+        }
+        let bytes = checked_file(r, SETS_FILE, part)?;
+        let doc: Value = serde_json::from_slice(&bytes)
+            .map_err(|e| refuse(format!("{d}: {SETS_FILE} is damaged ({e})")))?;
+        let list = doc
+            .as_array()
+            .filter(|l| l.len() == want.len())
+            .ok_or_else(|| {
+                refuse(format!(
+                    "{d}: {SETS_FILE} does not hold its {} sets",
+                    want.len()
+                ))
+            })?;
+        for (v, &i) in list.iter().zip(&want) {
+            if v["id"].as_u64() != Some(i as u64 + 1) {
+                return Err(refuse(format!("{d}: {SETS_FILE}: expected set {}", i + 1)));
+            }
+            let res = exact::from_json(v, sets[i].clone())
+                .map_err(|e| refuse(format!("{d}: {SETS_FILE}: set {}: {e}", i + 1)))?;
+            rs[i] = Some(res);
+        }
+        let listed = r.doc["figures"].as_array().cloned().unwrap_or_default();
+        if figures {
+            for &i in &want {
+                let dir = format!("figures/set{:02}/", i + 1);
+                if !listed
+                    .iter()
+                    .any(|f| f["file"].as_str().is_some_and(|f| f.starts_with(&dir)))
+                {
+                    return Err(refuse(format!(
+                        "{d}: {SHARD_FILE} lists no pictures of set {}; recompute this shard",
+                        i + 1
+                    )));
+                }
+            }
+        }
+        for f in &listed {
+            let file = f["file"].as_str().unwrap_or("");
+            let b = checked_file(r, file, f)?;
+            pictures.push((file.to_string(), b));
+        }
+    }
+    let rs: Vec<SetResult> = rs.into_iter().flatten().collect();
+    if rs.len() != sets.len() {
+        return Err(refuse(format!(
+            "the shards hold {} of the {} sets",
+            rs.len(),
+            sets.len()
+        )));
+    }
+    let stage = Staging::new(out)?;
+    for (file, bytes) in &pictures {
+        let p = stage.dir().join(file);
+        if let Some(parent) = p.parent() {
+            std::fs::create_dir_all(parent)
+                .map_err(|e| RunError::Io(format!("cannot create {}: {e}", parent.display())))?;
+        }
+        write_file(&p, bytes)?;
+    }
+    let cs = crate::commands::reproduce::finish(&stage, &rs, scale, figures)?;
+    let dest = stage.commit()?;
+    if json {
+        let doc = json!({
+            "sets": rs.len(), "shards": n, "figures": pictures.len(),
+            "conclusions": cs.iter().map(|c| json!({"id": c.id, "grade": c.grade.as_str()})).collect::<Vec<_>>(),
+            "out": dest,
+        });
+        crate::outln!(
+            "{}",
+            serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
+        );
+        return Ok(());
+    }
+    crate::commands::reproduce::print_summary(
+        &format!("merged {} sets from {n} shards", rs.len()),
+        &cs,
+        &dest,
+    );
+    Ok(())
 }
 
 #[cfg(test)]

@@ -20,7 +20,6 @@ use serde_json::{json, Value};
 use squeal_core::EventKind;
 use squeal_plot::{Colormap, Format, HeatmapSpec};
 use squeal_study::model::AnyModel;
-use squeal_study::scenario::{InputError, Setting};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -52,20 +51,26 @@ fn draw_set(
 /// Arguments of `squeal reproduce`.
 #[derive(Args, Debug)]
 pub struct ReproduceArgs {
-    /// Output folder.
-    #[arg(long, default_value = "out/reproduce")]
-    out: PathBuf,
+    /// Output folder (default: out/reproduce; a shard's: out/reproduce-shard-K-of-N).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
     /// Multiply every set's simulated duration by this factor (e.g. 0.1 for a
     /// quick look; the conclusions need the full durations).
     #[arg(long, default_value_t = 1.0)]
-    duration_scale: f64,
+    pub duration_scale: f64,
     /// Skip the per-set pictures (Appendix A).
     #[arg(long)]
-    no_figures: bool,
+    pub no_figures: bool,
+    /// Compute only shard K of N (K from 0): the sets whose index i (set
+    /// i + 1) has i mod N = K, written as `shard.json` + `part.json` (and
+    /// their Appendix A pictures) for `squeal merge`.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
 }
 
+use crate::commands::merge::{reproduce_study, write_reproduce_part, Shard};
 use squeal_study::reproduce::*;
-use squeal_study::scenario::thesis_sets;
+use squeal_study::Scenario;
 
 fn opt(x: Option<f64>, prec: usize) -> String {
     x.filter(|v| v.is_finite())
@@ -819,58 +824,56 @@ fn draw_map(rs: &[SetResult], dir: &Path) -> Result<String, RunError> {
     Ok(note)
 }
 
-/// Run the command.
-pub fn run(a: ReproduceArgs) -> Result<(), RunError> {
-    if !(a.duration_scale.is_finite() && a.duration_scale > 0.0 && a.duration_scale <= 10.0) {
-        return Err(InputError(format!(
-            "--duration-scale {}: must be in (0, 10]",
-            a.duration_scale
-        ))
-        .into());
-    }
-    let start = Instant::now();
-    let mut sets = thesis_sets();
-    for s in &mut sets {
-        let d = s.duration * a.duration_scale;
-        s.apply("duration", &Setting::Number(d))?;
-        squeal_study::feasible::prepare(s)?;
-    }
-    let stage = Staging::new(&a.out)?;
-    let figures = stage.dir().join("figures");
-    let pb = progress_bar(sets.len() as u64, "reproducing the thesis");
-    let results: Vec<Result<SetResult, RunError>> = sets
-        .into_par_iter()
-        .enumerate()
-        .map(|(i, sc)| {
+/// Measure the sets `ids` (indices into `sets`, set `i + 1`) in parallel,
+/// drawing Appendix A's pictures into `figures` if given; results in the
+/// order of `ids`, whatever the number of threads.
+fn measure_sets(
+    sets: &[Scenario],
+    ids: &[usize],
+    figures: Option<&Path>,
+    label: &str,
+) -> Result<Vec<SetResult>, RunError> {
+    let pb = progress_bar(ids.len() as u64, label);
+    let results: Vec<Result<SetResult, RunError>> = ids
+        .par_iter()
+        .map(|&i| {
+            let sc = sets[i].clone();
             let ch = sc.model.channels();
             let r = measure(i + 1, sc, &NEVER, |run, an| {
-                draw_set(
-                    i + 1,
-                    run,
-                    an,
-                    &ch,
-                    (!a.no_figures).then_some(figures.as_path()),
-                )
+                draw_set(i + 1, run, an, &ch, figures)
             });
             squeal_study::Progress::inc(&pb, 1);
             r
         })
         .collect();
     squeal_study::Progress::finish(&pb);
-    let mut rs = Vec::new();
-    for (i, r) in results.into_iter().enumerate() {
+    let mut rs = Vec::with_capacity(ids.len());
+    for (i, r) in ids.iter().zip(results) {
         rs.push(r.map_err(|e| RunError::Numerical(format!("set {}: {e}", i + 1)))?);
     }
+    Ok(rs)
+}
+
+/// Everything after the 40 sets: the sweeps around set 15, the
+/// conclusions, the V × N map and the report (`table.csv`,
+/// `conclusions.json`, `report.md`, `report.html`, `map.png`/`.svg`),
+/// written into `stage`. `reproduce` and `merge` both end here, so a merged
+/// report is the unsharded one byte for byte.
+pub fn finish(
+    stage: &Staging,
+    rs: &[SetResult],
+    duration_scale: f64,
+    figures: bool,
+) -> Result<Vec<Conclusion>, RunError> {
     let sw = sweeps(&rs[14].sc, &NEVER)?;
-    let cs = conclusions(&rs, &sw);
-    let map_note = draw_map(&rs, stage.dir())?;
-    let wall = start.elapsed().as_secs_f64();
+    let cs = conclusions(rs, &sw);
+    let map_note = draw_map(rs, stage.dir())?;
     let write = |name: &str, text: &str| {
         let p = stage.path(name);
         std::fs::write(&p, text)
             .map_err(|e| RunError::Io(format!("cannot write {}: {e}", p.display())))
     };
-    write("table.csv", &table_csv(&rs))?;
+    write("table.csv", &table_csv(rs))?;
     let cj: Vec<Value> = cs
         .iter()
         .map(|c| json!({ "id": c.id, "thesis": c.thesis, "claim": c.claim, "held": c.grade.held(), "grade": c.grade.as_str(), "caveat": c.caveat, "evidence": c.evidence, "data": c.data }))
@@ -879,15 +882,65 @@ pub fn run(a: ReproduceArgs) -> Result<(), RunError> {
         "conclusions.json",
         &(serde_json::to_string_pretty(&cj).map_err(|e| RunError::Io(e.to_string()))? + "\n"),
     )?;
-    let md = report_md(&rs, &cs, &sw, a.duration_scale, !a.no_figures, &map_note);
+    let md = report_md(rs, &cs, &sw, duration_scale, figures, &map_note);
     write("report.md", &md)?;
     write("report.html", &report_html(&md))?;
-    let dest = stage.commit()?;
-    crate::outln!("reproduced 40 sets in {wall:.1} s: {}", grade_counts(&cs));
-    for c in &cs {
+    Ok(cs)
+}
+
+/// The terminal lines after a report: the grades, each conclusion, where
+/// the report is.
+pub fn print_summary(head: &str, cs: &[Conclusion], dest: &Path) {
+    crate::outln!("{head}: {}", grade_counts(cs));
+    for c in cs {
         crate::outln!("  {}. {:<26} {}", c.id, c.grade.as_str(), c.thesis);
     }
     crate::outln!("report: {}", dest.join("report.html").display());
+}
+
+/// Run the command.
+pub fn run(a: ReproduceArgs) -> Result<(), RunError> {
+    let shard = a.shard.as_deref().map(Shard::parse).transpose()?;
+    let sets = prepared_sets(a.duration_scale)?;
+    let start = Instant::now();
+    let dest = a.out.clone().unwrap_or_else(|| {
+        PathBuf::from("out").join(match shard {
+            Some(s) => format!("reproduce-shard-{}-of-{}", s.k, s.n),
+            None => "reproduce".into(),
+        })
+    });
+    let flag = if a.out.is_some() {
+        "--out"
+    } else {
+        "output folder (default --out)"
+    };
+    let stage = Staging::new_as(flag, &dest)?;
+    let figures = stage.dir().join("figures");
+    let figures = (!a.no_figures).then_some(figures.as_path());
+    if let Some(s) = shard {
+        let ids = s.points(sets.len());
+        let label = format!("shard {}/{}: reproducing the thesis", s.k, s.n);
+        let rs = measure_sets(&sets, &ids, figures, &label)?;
+        let study = reproduce_study(&sets, a.duration_scale, !a.no_figures);
+        write_reproduce_part(&stage, &study, s, &rs)?;
+        let dest = stage.commit()?;
+        let list: Vec<String> = ids.iter().map(|i| (i + 1).to_string()).collect();
+        crate::outln!(
+            "reproduce: shard {}/{} — sets {} of 40; output: {} (shard.json, part.json{}); gather with `squeal merge`",
+            s.k,
+            s.n,
+            if list.is_empty() { "none".into() } else { list.join(", ") },
+            dest.display(),
+            if a.no_figures { "" } else { ", figures" }
+        );
+        return Ok(());
+    }
+    let ids: Vec<usize> = (0..sets.len()).collect();
+    let rs = measure_sets(&sets, &ids, figures, "reproducing the thesis")?;
+    let cs = finish(&stage, &rs, a.duration_scale, !a.no_figures)?;
+    let wall = start.elapsed().as_secs_f64();
+    let dest = stage.commit()?;
+    print_summary(&format!("reproduced 40 sets in {wall:.1} s"), &cs, &dest);
     Ok(())
 }
 

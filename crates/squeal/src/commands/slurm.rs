@@ -1,14 +1,15 @@
-//! `squeal slurm map … --tasks N [--partition P] [--time T]
+//! `squeal slurm map|reproduce … --tasks N [--partition P] [--time T]
 //! [--cpus-per-task C] [--jobs DIR] [--submit]`: a SLURM job array that
-//! computes a map in N shards, and a merge job that depends on it.
+//! computes a map (or the thesis's 40 sets) in N shards, and a merge job
+//! that depends on it.
 //!
 //! Writes into the jobs folder (default `OUT-slurm`):
 //! - `array.sh`: `#SBATCH --array=0-(N-1)`; task K runs `squeal map …
-//!   --shard K/N --out JOBS/shard-K/map` with `RAYON_NUM_THREADS` set to
+//!   --shard K/N --out JOBS/shard-K/map` (`squeal reproduce …`: `…/reproduce`) with `RAYON_NUM_THREADS` set to
 //!   `SLURM_CPUS_PER_TASK`; its log is `JOBS/shard-K.log`. Each shard has a
 //!   parent folder of its own: staging removes leftovers of dead processes
 //!   by PID in the parent folder, and PIDs of other nodes mean nothing here;
-//! - `merge.sh`: `squeal merge JOBS/shard-{0..N-1}/map --out OUT`, log
+//! - `merge.sh`: `squeal merge JOBS/shard-{0..N-1}/map --out OUT` (or `…/reproduce`), log
 //!   `JOBS/merge.log`.
 //!
 //! With `--submit` it runs `sbatch --parsable array.sh`, then `sbatch
@@ -17,6 +18,7 @@
 //! `sbatch --array=K JOBS/array.sh` (then `sbatch JOBS/merge.sh`).
 
 use crate::commands::map::{prepare, MapArgs};
+use crate::commands::reproduce::ReproduceArgs;
 use crate::run::{RunError, Staging};
 use clap::{Args, Subcommand};
 use squeal_study::scenario::InputError;
@@ -28,6 +30,9 @@ use std::process::Command;
 pub enum SlurmCmd {
     /// A stability map as a job array of shards and a dependent merge job.
     Map(SlurmMapArgs),
+    /// The thesis re-done (`squeal reproduce`) as a job array of shards of
+    /// its 40 sets and a dependent merge job that writes the report.
+    Reproduce(SlurmReproduceArgs),
 }
 
 /// Arguments of `squeal slurm map`: those of `map` and the job's.
@@ -35,6 +40,22 @@ pub enum SlurmCmd {
 pub struct SlurmMapArgs {
     #[command(flatten)]
     map: MapArgs,
+    #[command(flatten)]
+    job: JobArgs,
+}
+
+/// Arguments of `squeal slurm reproduce`: those of `reproduce` and the job's.
+#[derive(Args, Debug)]
+pub struct SlurmReproduceArgs {
+    #[command(flatten)]
+    rep: ReproduceArgs,
+    #[command(flatten)]
+    job: JobArgs,
+}
+
+/// The job array's settings, the same for every command.
+#[derive(Args, Debug)]
+pub struct JobArgs {
     /// Number of array tasks (shards).
     #[arg(long)]
     tasks: usize,
@@ -107,6 +128,19 @@ fn map_args(a: &MapArgs) -> Vec<String> {
     v
 }
 
+/// The `squeal reproduce …` arguments that fix the study (not --out, --shard).
+fn reproduce_args(a: &ReproduceArgs) -> Vec<String> {
+    let mut v = vec![
+        "reproduce".to_string(),
+        "--duration-scale".into(),
+        format!("{}", a.duration_scale),
+    ];
+    if a.no_figures {
+        v.push("--no-figures".into());
+    }
+    v
+}
+
 fn sbatch(args: &[&str]) -> Result<String, RunError> {
     let out = Command::new("sbatch")
         .args(args)
@@ -133,28 +167,71 @@ fn sbatch(args: &[&str]) -> Result<String, RunError> {
 
 /// Run the command.
 pub fn run(cmd: SlurmCmd) -> Result<(), RunError> {
-    let SlurmCmd::Map(a) = cmd;
-    if a.map.shard.is_some() {
-        return Err(InputError(
-            "--shard: not with `squeal slurm map` (each array task computes its own shard)".into(),
-        )
+    match cmd {
+        SlurmCmd::Map(a) => {
+            check_job(&a.job, a.map.shard.is_some(), "map")?;
+            let (sc, x, y) = prepare(&a.map)?;
+            let points = x.values.len() * y.values.len();
+            let out = a
+                .map
+                .out
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-map", sc.name)));
+            let what = format!("{} map of {points} points", sc.name);
+            let head = format!("{}: {points} points", sc.name);
+            scripts(&a.job, "map", &map_args(&a.map), &out, &what, &head)
+        }
+        SlurmCmd::Reproduce(a) => {
+            check_job(&a.job, a.rep.shard.is_some(), "reproduce")?;
+            let sets = squeal_study::reproduce::prepared_sets(a.rep.duration_scale)?;
+            let out = a
+                .rep
+                .out
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("out").join("reproduce"));
+            let what = format!("the thesis's {} sets", sets.len());
+            let head = format!("reproduce: {} sets", sets.len());
+            scripts(
+                &a.job,
+                "reproduce",
+                &reproduce_args(&a.rep),
+                &out,
+                &what,
+                &head,
+            )
+        }
+    }
+}
+
+fn check_job(job: &JobArgs, shard: bool, cmd: &str) -> Result<(), RunError> {
+    if shard {
+        return Err(InputError(format!(
+            "--shard: not with `squeal slurm {cmd}` (each array task computes its own shard)"
+        ))
         .into());
     }
-    if a.tasks == 0 {
+    if job.tasks == 0 {
         return Err(InputError("--tasks 0: need at least 1 task".into()).into());
     }
-    if a.cpus_per_task == Some(0) {
+    if job.cpus_per_task == Some(0) {
         return Err(InputError("--cpus-per-task 0: need at least 1 CPU".into()).into());
     }
-    word("--partition", &a.partition)?;
-    word("--time", &a.time)?;
-    let (sc, x, y) = prepare(&a.map)?;
-    let points = x.values.len() * y.values.len();
-    let out = abs(&a
-        .map
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-map", sc.name))))?;
+    word("--partition", &job.partition)?;
+    word("--time", &job.time)
+}
+
+/// Write (and with `--submit` submit) `array.sh` and `merge.sh` for the
+/// study `squeal ARGS…` (`args[0]` is the command, which also names each
+/// task's shard folder `JOBS/shard-K/CMD`), merged into `out`.
+fn scripts(
+    a: &JobArgs,
+    cmd: &str,
+    args: &[String],
+    out: &Path,
+    what: &str,
+    head_line: &str,
+) -> Result<(), RunError> {
+    let out = abs(out)?;
     let jobs = abs(&a.jobs.clone().unwrap_or_else(|| {
         let mut s = out.clone().into_os_string();
         s.push("-slurm");
@@ -181,14 +258,13 @@ pub fn run(cmd: SlurmCmd) -> Result<(), RunError> {
         common.push_str(&format!("#SBATCH --time={t}\n"));
     }
     head.push_str(&format!(
-        "# squeal {}: {} map of {points} points in {n} shards\n",
+        "# squeal {}: {what} in {n} shards\n",
         env!("CARGO_PKG_VERSION"),
-        sc.name
     ));
-    let study: Vec<String> = map_args(&a.map).iter().map(|s| sh(s)).collect();
+    let study: Vec<String> = args.iter().map(|s| sh(s)).collect();
     let mut array = head.clone();
     array.push_str(&format!(
-        "#SBATCH --job-name=squeal-map\n#SBATCH --array=0-{}\n",
+        "#SBATCH --job-name=squeal-{cmd}\n#SBATCH --array=0-{}\n",
         n - 1
     ));
     if let Some(c) = a.cpus_per_task {
@@ -201,7 +277,7 @@ pub fn run(cmd: SlurmCmd) -> Result<(), RunError> {
     array.push_str(&format!(
         "set -euo pipefail\n# squeal's threads: the task's CPUs\nexport RAYON_NUM_THREADS=\"${{SLURM_CPUS_PER_TASK:-1}}\"\n\
          K=\"$SLURM_ARRAY_TASK_ID\"\n\
-         exec {} {} --shard \"$K/{n}\" --out {}/shard-\"$K\"/map\n",
+         exec {} {} --shard \"$K/{n}\" --out {}/shard-\"$K\"/{cmd}\n",
         p(&exe),
         study.join(" "),
         p(&jobs)
@@ -212,7 +288,7 @@ pub fn run(cmd: SlurmCmd) -> Result<(), RunError> {
         p(&jobs.join("merge.log"))
     ));
     merge.push_str(&format!(
-        "set -euo pipefail\nexec {} merge {}/shard-{{0..{}}}/map --out {}\n",
+        "set -euo pipefail\nexec {} merge {}/shard-{{0..{}}}/{cmd} --out {}\n",
         p(&exe),
         p(&jobs),
         n - 1,
@@ -231,8 +307,7 @@ pub fn run(cmd: SlurmCmd) -> Result<(), RunError> {
     let jobs = stage.commit()?;
     let (arr, mer) = (jobs.join("array.sh"), jobs.join("merge.sh"));
     crate::outln!(
-        "{}: {points} points in {n} array tasks; scripts: {} and {}",
-        sc.name,
+        "{head_line} in {n} array tasks; scripts: {} and {}",
         arr.display(),
         mer.display()
     );
@@ -249,7 +324,7 @@ pub fn run(cmd: SlurmCmd) -> Result<(), RunError> {
     let dep = format!("--dependency=afterok:{id}");
     let mid = sbatch(&["--parsable", &dep, &mer.to_string_lossy()])?;
     crate::outln!("submitted: array job {id}, merge job {mid} (after the array succeeds)");
-    crate::outln!("merged map: {}", out.display());
+    crate::outln!("merged {cmd}: {}", out.display());
     Ok(())
 }
 
