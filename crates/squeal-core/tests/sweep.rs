@@ -307,3 +307,59 @@ fn a_mode_sweeping_through_nine_others_keeps_every_identity() {
         }
     }
 }
+
+/// A state-matrix function of the swept parameter.
+type StateAt<'a> = &'a dyn Fn(f64) -> Result<(DMatrix<f64>, Vec<f64>), StabilityError>;
+
+/// A sweep restarted from any value `t` (its own branch numbering) pairs
+/// the modes exactly as the whole sweep once its first step agrees with the
+/// whole sweep's: the assignment does not depend on how branches are
+/// numbered. This is what `sweep --shard` and `merge` rely on.
+#[test]
+fn a_sweep_resumed_from_a_slice_tracks_bit_for_bit() {
+    let (h, _) = undamped();
+    let crossing = |p: f64| -> Result<(DMatrix<f64>, Vec<f64>), StabilityError> {
+        let mut a = DMatrix::<f64>::zeros(4, 4);
+        a[(0, 2)] = 1.0;
+        a[(1, 3)] = 1.0;
+        a[(2, 0)] = -100.0;
+        a[(3, 1)] = -p * p;
+        a[(2, 2)] = -0.1;
+        a[(3, 3)] = -0.1;
+        Ok((a, vec![0.0; 4]))
+    };
+    let hoff = |mu: f64| hoffmann_at(&h, mu);
+    let cases: Vec<(Vec<f64>, StateAt)> = vec![
+        (linspace(0.02, 0.5, 37), &hoff),
+        (linspace(5.0, 15.0, 21), &crossing),
+    ];
+    let bits = |l: Complex<f64>| (l.re.to_bits(), l.im.to_bits());
+    let mut checked = 0;
+    for (values, f) in cases {
+        let o = SweepOptions::default();
+        let full = sweep(&values, f, &o).unwrap();
+        for t in 0..values.len() - 2 {
+            let part = sweep(&values[t..], f, &o).unwrap();
+            // π: part branch → whole-sweep branch, by the eigenvalues' bits at t.
+            let at = &full.lambda[t];
+            let pi: Option<Vec<usize>> = part.lambda[0]
+                .iter()
+                .map(|l| {
+                    let m: Vec<usize> =
+                        (0..at.len()).filter(|&b| bits(at[b]) == bits(*l)).collect();
+                    (m.len() == 1).then(|| m[0])
+                })
+                .collect();
+            let Some(pi) = pi else { continue }; // a double eigenvalue at t
+            let same_at = |i: usize| {
+                (0..pi.len()).all(|b| bits(part.lambda[i - t][b]) == bits(full.lambda[i][pi[b]]))
+            };
+            assert!(same_at(t + 1), "t = {t}: the first step pairs differently");
+            for i in t + 2..values.len() {
+                assert!(same_at(i), "t = {t}: differs at value {i}");
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked >= 40, "{checked}");
+}

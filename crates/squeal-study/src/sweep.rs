@@ -66,3 +66,248 @@ pub fn sweep_model(
         other => StudyError::Numerical(format!("eigen-analysis at {name} = {at}: {other}")),
     })
 }
+
+/// Sharded sweeps: contiguous slices of the values, each computed with two
+/// values of the slice before it, and merged into the [`Sweep`] of the
+/// whole.
+///
+/// Why this is exact. The tracking ([`squeal_core::stability::sweep`])
+/// pairs the eigenpairs of value `k` with those of `k − 1`, with each
+/// branch's eigenvalue extrapolated from `k − 2` and `k − 1`; its result
+/// does not depend on how the branches are numbered. So the pairing at
+/// value `k` depends on the pairings before it only through the pairing of
+/// `k − 2` with `k − 1`. Slice `K` owns the values `[a, b)` and computes
+/// `[a − 2, b)`: at `a − 1` it pairs without extrapolation (it has no
+/// history), from `a` on with. The same eigen-solve gives the same bits, so
+/// the merge reads the renumbering of slice `K`'s branches off the
+/// eigenvalues at `a − 2` and checks that at `a − 1` they pair as in slice
+/// `K − 1`; then every later pairing is the whole sweep's, bit for bit. If
+/// that check fails (the extrapolation changed a pairing right at the
+/// boundary) or a double eigenvalue makes the renumbering ambiguous, the
+/// merge refuses and names the value. Onsets are taken from the slice that
+/// owns the interval's upper value; which listed mode changes, and the
+/// listed modes themselves, are recomputed over the merged eigenvalues.
+pub mod shard {
+    use nalgebra::Complex;
+    use serde_json::{json, Value};
+    use squeal_core::stability::sweep::{listed_branches, onset_mode, Onset, Sweep};
+    use squeal_core::stability::Direction;
+    use std::ops::Range;
+
+    /// The values slice `k` of `n` owns, and the values it computes (two
+    /// more before, within the sweep). Contiguous, every value owned once.
+    pub fn slice(values: usize, k: usize, n: usize) -> (Range<usize>, Range<usize>) {
+        let own = k * values / n..(k + 1) * values / n;
+        let computed = own.start.saturating_sub(2)..own.end;
+        (own, computed)
+    }
+
+    /// What a slice computed: eigenvalues from `start` on, and the onsets
+    /// whose interval ends at a value it owns.
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct Part {
+        /// Index of the first computed value in the whole sweep.
+        pub start: usize,
+        /// `lambda[i][b]`: eigenvalue of the slice's branch `b` at value `start + i`.
+        pub lambda: Vec<Vec<Complex<f64>>>,
+        /// `(k, onset)`: an onset between values `k − 1` and `k`.
+        pub onsets: Vec<(usize, Onset)>,
+    }
+
+    /// The part of slice `k` of `n` from the sweep `sw` of its computed
+    /// values `values[computed]` (see [`slice`]).
+    pub fn part_of(values: &[f64], k: usize, n: usize, sw: &Sweep) -> Part {
+        let (own, computed) = slice(values.len(), k, n);
+        let local = &values[computed.clone()];
+        // The interval of each onset: the first whose ends enclose it.
+        let onsets = sw
+            .onsets
+            .iter()
+            .filter_map(|o| {
+                let i = (1..local.len()).find(|&i| {
+                    let (a, b) = (local[i - 1], local[i]);
+                    a.min(b) <= o.value && o.value <= a.max(b)
+                })?;
+                let g = computed.start + i;
+                own.contains(&g).then_some((g, *o))
+            })
+            .collect();
+        Part {
+            start: computed.start,
+            lambda: sw.lambda.clone(),
+            onsets,
+        }
+    }
+
+    fn x(v: f64) -> String {
+        format!("{v:e}")
+    }
+
+    /// A part as JSON, every number as exact text (`{:e}`).
+    pub fn to_json(p: &Part) -> Value {
+        json!({
+            "start": p.start,
+            "lambda": p.lambda.iter().map(|row| {
+                row.iter().map(|l| format!("{} {}", x(l.re), x(l.im))).collect::<Vec<_>>()
+            }).collect::<Vec<_>>(),
+            "onsets": p.onsets.iter().map(|(k, o)| json!({
+                "k": k,
+                "value": x(o.value),
+                "freq_hz": x(o.freq_hz),
+                "direction": o.direction,
+                "coalescence": o.coalescence,
+            })).collect::<Vec<_>>(),
+        })
+    }
+
+    /// Read a part back; the error names the field.
+    pub fn from_json(v: &Value) -> Result<Part, String> {
+        let num = |s: &str, what: &str| {
+            s.parse::<f64>()
+                .map_err(|_| format!("{what}: bad number {s:?}"))
+        };
+        let start = v["start"].as_u64().ok_or("start: not a whole number")? as usize;
+        let lambda = v["lambda"]
+            .as_array()
+            .ok_or("lambda: not a list")?
+            .iter()
+            .map(|row| {
+                row.as_array()
+                    .ok_or_else(|| "lambda: not a list".to_string())?
+                    .iter()
+                    .map(|l| {
+                        let s = l.as_str().ok_or("lambda: not text")?;
+                        let (re, im) = s.split_once(' ').ok_or("lambda: expected \"RE IM\"")?;
+                        Ok(Complex::new(num(re, "lambda")?, num(im, "lambda")?))
+                    })
+                    .collect::<Result<Vec<_>, String>>()
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        let onsets = v["onsets"]
+            .as_array()
+            .ok_or("onsets: not a list")?
+            .iter()
+            .map(|o| {
+                let k = o["k"].as_u64().ok_or("onsets.k: not a whole number")? as usize;
+                let direction = match o["direction"].as_str() {
+                    Some("destabilising") => Direction::Destabilising,
+                    Some("stabilising") => Direction::Stabilising,
+                    _ => return Err("onsets.direction: unknown".to_string()),
+                };
+                let text = |key: &str| o[key].as_str().ok_or(format!("onsets.{key}: not text"));
+                Ok((
+                    k,
+                    Onset {
+                        value: num(text("value")?, "onsets.value")?,
+                        freq_hz: num(text("freq_hz")?, "onsets.freq_hz")?,
+                        mode: None,
+                        direction,
+                        coalescence: o["coalescence"]
+                            .as_bool()
+                            .ok_or("onsets.coalescence: not true/false")?,
+                    },
+                ))
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        Ok(Part {
+            start,
+            lambda,
+            onsets,
+        })
+    }
+
+    fn bits(l: Complex<f64>) -> (u64, u64) {
+        (l.re.to_bits(), l.im.to_bits())
+    }
+
+    /// Merge the parts of slices `0 … n − 1` (in that order) of a sweep of
+    /// `values` into the whole sweep (`mac` is not kept: empty). Errors say
+    /// which slice and value do not fit.
+    pub fn merge(values: &[f64], parts: &[Part]) -> Result<Sweep, String> {
+        let n = parts.len();
+        let mut lambda: Vec<Vec<Complex<f64>>> = Vec::with_capacity(values.len());
+        let mut onsets: Vec<(usize, Onset)> = Vec::new();
+        for (k, p) in parts.iter().enumerate() {
+            let (own, computed) = slice(values.len(), k, n);
+            if p.start != computed.start || p.lambda.len() != computed.len() {
+                return Err(format!(
+                    "slice {k}/{n} should hold values {}–{}, it holds {} from {}",
+                    computed.start,
+                    computed.end.saturating_sub(1),
+                    p.lambda.len(),
+                    p.start
+                ));
+            }
+            if p.lambda
+                .iter()
+                .any(|r| Some(r.len()) != lambda.first().or(p.lambda.first()).map(Vec::len))
+            {
+                return Err(format!("slice {k}/{n}: the number of eigenvalues differs"));
+            }
+            let shared = own.start - computed.start;
+            let pi: Vec<usize> = if shared == 0 {
+                (0..p.lambda.first().map_or(0, Vec::len)).collect()
+            } else {
+                // The renumbering, from the eigenvalues at the first shared value.
+                let at = &lambda[computed.start];
+                let mut pi = Vec::with_capacity(at.len());
+                for l in &p.lambda[0] {
+                    let m: Vec<usize> =
+                        (0..at.len()).filter(|&b| bits(at[b]) == bits(*l)).collect();
+                    if m.len() != 1 {
+                        return Err(format!(
+                            "slice {k}/{n}: a repeated eigenvalue at {} makes its modes ambiguous; use fewer shards",
+                            values[computed.start]
+                        ));
+                    }
+                    pi.push(m[0]);
+                }
+                for i in 1..shared {
+                    let g = computed.start + i;
+                    if (0..pi.len()).any(|b| bits(p.lambda[i][b]) != bits(lambda[g][pi[b]])) {
+                        return Err(format!(
+                            "slices {}/{n} and {k}/{n} pair the modes differently at {} (a boundary the tracking's extrapolation decides); use fewer or other shards",
+                            k - 1,
+                            values[g]
+                        ));
+                    }
+                }
+                pi
+            };
+            for row in &p.lambda[shared..] {
+                let mut r = vec![Complex::new(0.0, 0.0); row.len()];
+                for (b, l) in row.iter().enumerate() {
+                    r[pi[b]] = *l;
+                }
+                lambda.push(r);
+            }
+            onsets.extend(p.onsets.iter().copied());
+        }
+        if lambda.len() != values.len() {
+            return Err(format!(
+                "the slices hold {} of {} values",
+                lambda.len(),
+                values.len()
+            ));
+        }
+        let listed = listed_branches(&lambda);
+        onsets.sort_by_key(|o| o.0);
+        let onsets = onsets
+            .into_iter()
+            .map(|(k, mut o)| {
+                if k == 0 || k >= lambda.len() {
+                    return Err(format!("an onset in no interval (value index {k})"));
+                }
+                o.mode = onset_mode(&listed, &lambda[k - 1], &lambda[k]);
+                Ok(o)
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        Ok(Sweep {
+            values: values.to_vec(),
+            lambda,
+            mac: Vec::new(),
+            listed,
+            onsets,
+        })
+    }
+}

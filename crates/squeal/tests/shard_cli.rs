@@ -621,3 +621,117 @@ fn slurm_reproduce_scripts_run_as_an_array_and_merge() {
     bash("merge.sh", None);
     same_tree(&dir.join("full"), &dir.join("merged"));
 }
+
+const SWEEP_HOFFMANN: [&str; 8] = [
+    "sweep",
+    "hoffmann",
+    "--param",
+    "mu=0.05:0.5:46",
+    "--set",
+    "c1=0",
+    "--set",
+    "c2=0",
+];
+const SWEEP_DISC_PAD: [&str; 4] = ["sweep", "disc-pad", "--param", "V=0.5:20:40"];
+
+/// The `--json` document without its `out`.
+fn json_without_out(out: &Output) -> serde_json::Value {
+    let mut j: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON only");
+    j.as_object_mut().unwrap().remove("out");
+    j
+}
+
+#[test]
+fn sweep_shards_merge_byte_identical() {
+    for base in [&SWEEP_HOFFMANN[..], &SWEEP_DISC_PAD[..]] {
+        let d = tempfile::tempdir().unwrap();
+        let dir = d.path();
+        let full = json_without_out(&squeal(dir, &with(base, &["--out", "full", "--json"])));
+        assert!(
+            !full["onsets"].as_array().unwrap().is_empty(),
+            "{base:?}: the sweep should cross a change of stability: {full}"
+        );
+        // 46 values in 7 slices of 6 or 7; 40 in 3 of 13 or 14.
+        for n in [1usize, 2, 3, 7] {
+            let mut args: Vec<String> = vec!["merge".into()];
+            for k in (0..n).rev() {
+                let out = format!("s{n}-{k}");
+                squeal(
+                    dir,
+                    &with(base, &["--shard", &format!("{k}/{n}"), "--out", &out]),
+                );
+                args.push(out);
+            }
+            let m = format!("m{n}");
+            args.extend(["--out".into(), m.clone(), "--json".into()]);
+            let args: Vec<&str> = args.iter().map(String::as_str).collect();
+            let merged = json_without_out(&squeal(dir, &args));
+            assert_eq!(merged, full, "{base:?}: --json after merging {n} shards");
+            for f in ["sweep.csv", "sweep.png", "sweep.svg"] {
+                let a = std::fs::read(dir.join("full").join(f)).unwrap();
+                let b = std::fs::read(dir.join(&m).join(f)).unwrap();
+                assert!(a == b, "{base:?}: {f} differs after merging {n} shards");
+            }
+        }
+    }
+}
+
+#[test]
+fn merge_refuses_bad_sweep_shards() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    for k in 0..3 {
+        squeal(
+            dir,
+            &with(
+                &SWEEP_HOFFMANN,
+                &["--shard", &format!("{k}/3"), "--out", &format!("a{k}")],
+            ),
+        );
+    }
+    let m = ["--out", "merged"];
+    // 46 values: slices 0–14, 15–29, 30–45.
+    refused(
+        dir,
+        &with(&["merge", "a0", "a2"], &m),
+        "missing shard 1/3 (values 15, 16, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26 … (15 in all))",
+    );
+    refused(
+        dir,
+        &with(&["merge", "a0", "a1", "a1", "a2"], &m),
+        "shard 1/3 given twice",
+    );
+    let mut other = SWEEP_HOFFMANN;
+    other[3] = "mu=0.05:0.6:46";
+    squeal(dir, &with(&other, &["--shard", "1/3", "--out", "b1"]));
+    refused(
+        dir,
+        &with(&["merge", "a0", "b1", "a2"], &m),
+        "different --param",
+    );
+    squeal(
+        dir,
+        &with(
+            &SWEEP_HOFFMANN,
+            &["--set", "c1=0.1", "--shard", "1/3", "--out", "c1"],
+        ),
+    );
+    refused(
+        dir,
+        &with(&["merge", "a0", "c1", "a2"], &m),
+        "different scenarios",
+    );
+    let part = dir.join("a1/part.json");
+    let text = std::fs::read_to_string(&part).unwrap();
+    std::fs::write(&part, &text[..text.len() - 10]).unwrap();
+    refused(
+        dir,
+        &with(&["merge", "a0", "a1", "a2"], &m),
+        "a1: part.json is truncated or changed",
+    );
+    refused(
+        dir,
+        &with(&SWEEP_HOFFMANN, &["--shard", "0/47", "--out", "merged"]),
+        "--shard 0/47: more shards than the 46 values",
+    );
+}

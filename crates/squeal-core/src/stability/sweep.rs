@@ -126,23 +126,36 @@ where
     let mut growing_count: Vec<usize> = Vec::with_capacity(values.len());
     // Branch state at the previous point: eigenvalue and shape.
     let mut prev: Vec<EigenPair> = Vec::new();
+    // prev_idx[b]: the solver's index of branch b's eigenpair at the previous
+    // value (the assignment reads the branches in that order, so that it
+    // does not depend on how the branches are numbered).
+    let mut prev_idx: Vec<usize> = Vec::new();
     let mut dim = 0;
     for (k, &p) in values.iter().enumerate() {
         let (a, _) = f(p)?;
-        let mut pairs = modal::eigenpairs(&a)?;
+        let pairs = modal::eigenpairs(&a)?;
         growing_count.push(pairs.iter().filter(|(l, _)| is_growing(l.re, l.im)).count());
         if k == 0 {
             dim = pairs.len();
-            // Initial order: frequency ascending, growth descending, +ω first.
-            pairs.sort_by(|(x, _), (y, _)| {
+            // Initial order: frequency ascending, growth descending, +ω first
+            // (a stable sort: equal eigenvalues keep the solver's order).
+            let mut order: Vec<usize> = (0..dim).collect();
+            order.sort_by(|&a, &b| {
+                let (x, y) = (pairs[a].0, pairs[b].0);
                 x.im.abs()
                     .total_cmp(&y.im.abs())
                     .then(y.re.total_cmp(&x.re))
                     .then(y.im.total_cmp(&x.im))
             });
+            let mut slots: Vec<Option<EigenPair>> = pairs.into_iter().map(Some).collect();
+            let pairs: Vec<EigenPair> = order
+                .iter()
+                .map(|&j| slots[j].take().expect("a sort is a permutation"))
+                .collect();
             lambda.push(pairs.iter().map(|(l, _)| *l).collect());
             mac.push(vec![1.0; dim]);
             prev = pairs;
+            prev_idx = order;
             continue;
         }
         if pairs.len() != dim {
@@ -164,7 +177,7 @@ where
                 }
             })
             .collect();
-        let (assign, macs) = match_branches(&prev, &predicted, &pairs);
+        let (assign, macs) = match_branches(&prev, &prev_idx, &predicted, &pairs);
         let mut next: Vec<EigenPair> = Vec::with_capacity(dim);
         let mut pairs: Vec<Option<EigenPair>> = pairs.into_iter().map(Some).collect();
         for &j in &assign {
@@ -173,6 +186,7 @@ where
         lambda.push(next.iter().map(|(l, _)| *l).collect());
         mac.push(macs);
         prev = next;
+        prev_idx = assign;
     }
     let listed = listed_branches(&lambda);
     let mut onsets = Vec::new();
@@ -225,15 +239,25 @@ pub fn mac(x: &[Complex<f64>], y: &[Complex<f64>]) -> f64 {
     }
 }
 
-/// The assignment of branches (previous eigenpairs `prev`, predictions
-/// `predicted`) to the new eigenpairs `new`: `assign[b] = j`, and the MAC of
-/// each match.
+/// The assignment of branches (previous eigenpairs `prev`, the solver's
+/// index `prev_idx` of each, predictions `predicted`) to the new eigenpairs
+/// `new`: `assign[b] = j`, and the MAC of each match. The cost matrix's rows
+/// are the branches in the order of `prev_idx`, not of their numbers: the
+/// result is the same however the branches are numbered (a sweep resumed
+/// from a slice of the values, with branches numbered its own way, pairs
+/// the modes exactly as the whole sweep does — what sharded sweeps rely on).
 fn match_branches(
     prev: &[EigenPair],
+    prev_idx: &[usize],
     predicted: &[Complex<f64>],
     new: &[EigenPair],
 ) -> (Vec<usize>, Vec<f64>) {
     let n = new.len();
+    // rows[r] = the branch whose previous eigenpair the solver gave r-th.
+    let mut rows = vec![0; n];
+    for (b, &i) in prev_idx.iter().enumerate() {
+        rows[i] = b;
+    }
     let dist = |b: usize, j: usize| {
         let (x, y) = (predicted[b], new[j].0);
         let scale = x.norm().max(y.norm());
@@ -248,10 +272,10 @@ fn match_branches(
     let mut order: Vec<usize> = (0..n).collect();
     let mut d = vec![0.0; n];
     let k = CANDIDATES.min(n);
-    for b in 0..n {
+    for (r, &b) in rows.iter().enumerate() {
         for j in 0..n {
             d[j] = dist(b, j);
-            cost[b * n + j] = 1.0 + d[j];
+            cost[r * n + j] = 1.0 + d[j];
         }
         // The k nearest (ties by index: deterministic), in O(n).
         order.iter_mut().enumerate().for_each(|(i, o)| *o = i);
@@ -260,16 +284,17 @@ fn match_branches(
         }
         for &j in &order[..k] {
             let m = mac(shape(&prev[b].1), shape(&new[j].1));
-            macs[b * n + j] = m;
-            cost[b * n + j] = (1.0 - m) + d[j];
+            macs[r * n + j] = m;
+            cost[r * n + j] = (1.0 - m) + d[j];
         }
     }
-    let assign = hungarian(&cost, n);
-    let m = assign
-        .iter()
-        .enumerate()
-        .map(|(b, &j)| macs[b * n + j])
-        .collect();
+    let by_row = hungarian(&cost, n);
+    let mut assign = vec![0; n];
+    let mut m = vec![0.0; n];
+    for (r, &j) in by_row.iter().enumerate() {
+        assign[rows[r]] = j;
+        m[rows[r]] = macs[r * n + j];
+    }
     (assign, m)
 }
 
@@ -340,8 +365,10 @@ pub fn hungarian(cost: &[f64], n: usize) -> Vec<usize> {
 }
 
 /// Branches to report (see [`Sweep::listed`]), ordered by frequency then
-/// growth rate (descending) at the first point.
-fn listed_branches(lambda: &[Vec<Complex<f64>>]) -> Vec<usize> {
+/// growth rate (descending) at the first point; `lambda[k][b]` as in
+/// [`Sweep::lambda`]. Public so that a sweep merged from slices lists its
+/// modes as the whole sweep does.
+pub fn listed_branches(lambda: &[Vec<Complex<f64>>]) -> Vec<usize> {
     let dim = lambda.first().map_or(0, |l| l.len());
     let conj_of = |a: usize, b: usize| {
         lambda.iter().all(|l| {
@@ -367,6 +394,20 @@ fn listed_branches(lambda: &[Vec<Complex<f64>>]) -> Vec<usize> {
             .then(a.cmp(&b))
     });
     out
+}
+
+/// [`Onset::mode`]: the first listed branch (an index into `listed`) whose
+/// verdict differs between the eigenvalues `lam_lo` and `lam_hi` of the
+/// interval's two grid values (branch order of [`Sweep::lambda`]).
+pub fn onset_mode(
+    listed: &[usize],
+    lam_lo: &[Complex<f64>],
+    lam_hi: &[Complex<f64>],
+) -> Option<usize> {
+    listed.iter().position(|&b| {
+        let (a, c) = (lam_lo[b], lam_hi[b]);
+        is_growing(a.re, a.im) != is_growing(c.re, c.im)
+    })
 }
 
 /// Bisection on the number of growing eigenvalues between `(lo, c_lo)` and
@@ -437,10 +478,7 @@ where
                 && o.im.signum() == g.im.signum()
                 && (o.im - g.im).abs() <= 0.01 * g.im.abs()
         });
-    let mode = listed.iter().position(|&b| {
-        let (a, c) = (lam_lo[b], lam_hi[b]);
-        is_growing(a.re, a.im) != is_growing(c.re, c.im)
-    });
+    let mode = onset_mode(listed, lam_lo, lam_hi);
     Ok(Onset {
         value,
         freq_hz: g.im.abs() / (2.0 * std::f64::consts::PI),

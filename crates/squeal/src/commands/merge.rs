@@ -204,6 +204,43 @@ pub fn write_reproduce_part(
     write_file(&stage.path(SHARD_FILE), (text + "\n").as_bytes())
 }
 
+/// The study a `sweep` shard belongs to: the squeal version, the resolved
+/// scenario and its hash, the swept parameter with every value and its label.
+pub fn sweep_study(sc: &Scenario, p: &Axis, label: &str) -> Value {
+    let content = sc.to_json();
+    let text = serde_json::to_string(&content).unwrap_or_default();
+    json!({
+        "command": "sweep",
+        "squeal_version": env!("CARGO_PKG_VERSION"),
+        "scenario": { "name": sc.name, "hash": fnv1a(text.as_bytes()), "content": content },
+        "param": axis_json(p, label),
+    })
+}
+
+/// Write a `sweep` shard (`part.json`, then `shard.json`) into `stage`.
+pub fn write_sweep_part(
+    stage: &Staging,
+    study: &Value,
+    s: Shard,
+    part: &squeal_study::sweep::shard::Part,
+) -> Result<(), RunError> {
+    let bytes = serde_json::to_string(&squeal_study::sweep::shard::to_json(part))
+        .map_err(|e| RunError::Io(e.to_string()))?
+        + "\n";
+    write_file(&stage.path(SETS_FILE), bytes.as_bytes())?;
+    let doc = json!({
+        "format": FORMAT,
+        "study": study,
+        "k": s.k,
+        "n": s.n,
+        "slicing": "contiguous: shard k owns values [k·m/n, (k+1)·m/n) of m and computes from two values before",
+        "points": part.lambda.len(),
+        "part": { "file": SETS_FILE, "rows": part.lambda.len(), "bytes": bytes.len(), "fnv1a": fnv1a(bytes.as_bytes()) },
+    });
+    let text = serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?;
+    write_file(&stage.path(SHARD_FILE), (text + "\n").as_bytes())
+}
+
 /// Write a shard (`part.csv` then `shard.json`) into `stage`.
 #[allow(clippy::too_many_arguments)]
 pub fn write_part(
@@ -333,6 +370,9 @@ fn difference(a: &Value, b: &Value) -> Option<String> {
     };
     if a["scenario"] != b["scenario"] {
         return Some(format!("different scenarios: {} and {}", h(a), h(b)));
+    }
+    if a["param"] != b["param"] {
+        return Some("different --param (name or values)".into());
     }
     if a["grid"] != b["grid"] {
         return Some("different grids (axes or their values)".into());
@@ -485,33 +525,46 @@ pub fn run(a: MergeArgs) -> Result<(), RunError> {
         }
         by_k[r.k] = Some(r);
     }
-    let reproduce = study["command"] == "reproduce";
-    let (total, x, y) = if reproduce {
-        let count = study["sets"]["count"].as_u64().unwrap_or(0) as usize;
-        (count, None, None)
-    } else {
-        let bad_grid = |e: String| refuse(format!("{}: {SHARD_FILE}: {e}", first.dir.display()));
-        let x = axis_of(&study["grid"]["x"]).map_err(bad_grid)?;
-        let y = axis_of(&study["grid"]["y"]).map_err(bad_grid)?;
-        (x.values.len() * y.values.len(), Some(x), Some(y))
+    let command = study["command"].as_str().unwrap_or("map").to_string();
+    let bad_grid = |e: String| refuse(format!("{}: {SHARD_FILE}: {e}", first.dir.display()));
+    let (total, x, y) = match command.as_str() {
+        "reproduce" => {
+            let count = study["sets"]["count"].as_u64().unwrap_or(0) as usize;
+            (count, None, None)
+        }
+        "sweep" => {
+            let p = axis_of(&study["param"]).map_err(bad_grid)?;
+            (p.values.len(), Some(p), None)
+        }
+        _ => {
+            let x = axis_of(&study["grid"]["x"]).map_err(bad_grid)?;
+            let y = axis_of(&study["grid"]["y"]).map_err(bad_grid)?;
+            (x.values.len() * y.values.len(), Some(x), Some(y))
+        }
     };
     let missing: Vec<usize> = (0..n).filter(|k| by_k[*k].is_none()).collect();
     if !missing.is_empty() {
         let ks: Vec<String> = missing.iter().map(|k| format!("{k}/{n}")).collect();
         let mut points: Vec<usize> = missing
             .iter()
-            .flat_map(|&k| Shard { k, n }.points(total))
+            .flat_map(|&k| {
+                if command == "sweep" {
+                    squeal_study::sweep::shard::slice(total, k, n).0.collect()
+                } else {
+                    Shard { k, n }.points(total)
+                }
+            })
             .collect();
         points.sort_unstable();
-        // Sets are numbered from 1.
-        let (what, first_no, cmd) = if reproduce {
-            ("sets", 1, "reproduce")
-        } else {
-            ("points", 0, "map")
+        // Sets are numbered from 1; points and values (their index) from 0.
+        let (what, first_no) = match command.as_str() {
+            "reproduce" => ("sets", 1),
+            "sweep" => ("values", 0),
+            _ => ("points", 0),
         };
         let named: Vec<usize> = points.iter().map(|p| p + first_no).collect();
         return Err(refuse(format!(
-            "missing shard {} ({what} {}): recompute with `squeal {cmd} … --shard K/N`",
+            "missing shard {} ({what} {}): recompute with `squeal {command} … --shard K/N`",
             ks.join(", "),
             if named.is_empty() {
                 "none".into()
@@ -520,8 +573,10 @@ pub fn run(a: MergeArgs) -> Result<(), RunError> {
             }
         )));
     }
-    let (Some(x), Some(y)) = (x, y) else {
-        return merge_reproduce(&shards, n, &a.out, a.json);
+    let (x, y) = match (x, y) {
+        (Some(x), Some(y)) => (x, y),
+        (Some(p), None) => return merge_sweep(&shards, n, &p, &a.out, a.json),
+        _ => return merge_reproduce(&shards, n, &a.out, a.json),
     };
     let mut lin = vec![(f64::NAN, f64::NAN); total];
     let mut trans = (study["transient"] == true).then(|| vec![Outcome::FAILED; total]);
@@ -596,6 +651,40 @@ fn checked_file(r: &Read, file: &str, entry: &Value) -> Result<Vec<u8>, RunError
         )));
     }
     Ok(bytes)
+}
+
+/// Merge `sweep` shards (already checked to be one whole study) into the
+/// files of the unsharded `sweep`.
+fn merge_sweep(
+    shards: &[Read],
+    n: usize,
+    p: &Axis,
+    out: &Path,
+    json: bool,
+) -> Result<(), RunError> {
+    use squeal_study::sweep::shard;
+    let mut by_k: Vec<&Read> = shards.iter().collect();
+    by_k.sort_by_key(|r| r.k);
+    let mut parts = Vec::with_capacity(n);
+    for r in &by_k {
+        let d = r.dir.display();
+        let bytes = checked_file(r, SETS_FILE, &r.doc["part"])?;
+        let doc: Value = serde_json::from_slice(&bytes)
+            .map_err(|e| refuse(format!("{d}: {SETS_FILE} is damaged ({e})")))?;
+        let part = shard::from_json(&doc).map_err(|e| refuse(format!("{d}: {SETS_FILE}: {e}")))?;
+        parts.push(part);
+    }
+    let sw = shard::merge(&p.values, &parts).map_err(refuse)?;
+    let study = &shards[0].doc["study"];
+    let name = study["scenario"]["name"].as_str().unwrap_or("sweep");
+    let label = study["param"]["label"].as_str().unwrap_or(&p.name);
+    let stage = Staging::new(out)?;
+    crate::commands::sweep::write_sweep(&stage, name, p, label, &sw)?;
+    let dest = stage.commit()?;
+    if !json {
+        crate::outln!("merged {} values from {n} shards", p.values.len());
+    }
+    crate::commands::sweep::report(name, &p.name, &sw, &dest, json)
 }
 
 /// Merge `reproduce` shards (already checked to be one whole study) into

@@ -3,14 +3,16 @@
 //! continuously by shape (`squeal_core::stability::sweep`), written as
 //! `sweep.csv` and drawn as the mode-coupling diagram (`sweep.png/.svg`).
 
+use crate::commands::merge::Shard;
 use crate::commands::simulate::resolve;
 use crate::run::{RunError, Staging, NEVER};
 use crate::ScenarioArgs;
 use clap::Args;
 use serde_json::json;
+use squeal_core::stability::sweep::Sweep;
 use squeal_core::stability::Direction;
 use squeal_plot::{BranchSeries, Format, ModeCouplingSpec};
-use squeal_study::map::{parse_axis, unit_of};
+use squeal_study::map::{parse_axis, unit_of, Axis};
 use squeal_study::sweep::sweep_model;
 use std::io::Write;
 use std::path::PathBuf;
@@ -29,6 +31,12 @@ pub struct SweepArgs {
     /// Print the onsets and coalescences as JSON on stdout.
     #[arg(long)]
     json: bool,
+    /// Compute only shard K of N (K from 0): the K-th of N contiguous
+    /// slices of the values (and the two values before it, to track the
+    /// modes across the boundary), written as `shard.json` + `part.json`
+    /// for `squeal merge`.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<String>,
 }
 
 fn num(x: f64) -> String {
@@ -43,12 +51,90 @@ fn num(x: f64) -> String {
 pub fn run(a: SweepArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
     let axis = parse_axis(&a.param, "--param", false, &sc.model)?;
-    let dest = a
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", sc.name)));
-    let stage = Staging::new(&dest)?;
+    let shard = a.shard.as_deref().map(Shard::parse).transpose()?;
+    if let Some(s) = shard {
+        if s.n > axis.values.len() {
+            return Err(squeal_study::scenario::InputError(format!(
+                "--shard {}/{}: more shards than the {} values of --param {}",
+                s.k,
+                s.n,
+                axis.values.len(),
+                a.param
+            ))
+            .into());
+        }
+    }
+    let dest = a.out.clone().unwrap_or_else(|| {
+        let base = format!("{}-sweep", sc.name);
+        PathBuf::from("out").join(match shard {
+            Some(s) => format!("{base}-shard-{}-of-{}", s.k, s.n),
+            None => base,
+        })
+    });
+    let flag = if a.out.is_some() {
+        "--out"
+    } else {
+        "output folder (default --out)"
+    };
+    let stage = Staging::new_as(flag, &dest)?;
+    let unit = unit_of(&sc.model, &axis.name);
+    let xl = if unit.is_empty() {
+        axis.name.clone()
+    } else {
+        format!("{} ({unit})", axis.name)
+    };
+    if let Some(s) = shard {
+        use squeal_study::sweep::shard::{part_of, slice};
+        let (_, computed) = slice(axis.values.len(), s.k, s.n);
+        let sw = sweep_model(
+            &sc.model,
+            &axis.name,
+            &axis.values[computed.clone()],
+            &a.param,
+            &NEVER,
+        )?;
+        let part = part_of(&axis.values, s.k, s.n, &sw);
+        let study = crate::commands::merge::sweep_study(&sc, &axis, &xl);
+        crate::commands::merge::write_sweep_part(&stage, &study, s, &part)?;
+        let out = stage.commit()?;
+        let (own, _) = slice(axis.values.len(), s.k, s.n);
+        if a.json {
+            let doc = json!({ "shard": s.k, "shards": s.n, "values": own.len(), "first": own.start, "computed_from": computed.start, "out": out });
+            crate::outln!(
+                "{}",
+                serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
+            );
+        } else {
+            crate::outln!(
+                "{}: shard {}/{} — values {}–{} of {} (tracked from value {}); output: {} (shard.json, part.json); gather with `squeal merge`",
+                sc.name,
+                s.k,
+                s.n,
+                own.start,
+                own.end - 1,
+                axis.values.len(),
+                computed.start,
+                out.display()
+            );
+        }
+        return Ok(());
+    }
     let sw = sweep_model(&sc.model, &axis.name, &axis.values, &a.param, &NEVER)?;
+    write_sweep(&stage, &sc.name, &axis, &xl, &sw)?;
+    let out = stage.commit()?;
+    report(&sc.name, &axis.name, &sw, &out, a.json)
+}
+
+/// Write `sweep.csv` and the mode-coupling diagram (`sweep.png`/`.svg`) of
+/// `sw` into `stage`. `sweep` and `merge` both write through this, so a
+/// merged sweep is the unsharded one byte for byte.
+pub fn write_sweep(
+    stage: &Staging,
+    name: &str,
+    axis: &Axis,
+    xl: &str,
+    sw: &Sweep,
+) -> Result<(), RunError> {
     let path = stage.path("sweep.csv");
     let io = |e: std::io::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
     let mut w = std::io::BufWriter::new(std::fs::File::create(&path).map_err(io)?);
@@ -108,16 +194,10 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
         .filter(|o| o.coalescence)
         .map(|o| (o.value, o.freq_hz))
         .collect();
-    let unit = unit_of(&sc.model, &axis.name);
-    let xl = if unit.is_empty() {
-        axis.name.clone()
-    } else {
-        format!("{} ({unit})", axis.name)
-    };
-    let title = format!("{}: mode-coupling diagram", sc.name);
+    let title = format!("{name}: mode-coupling diagram");
     let spec = ModeCouplingSpec {
         title: &title,
-        x_label: &xl,
+        x_label: xl,
         x: &sw.values,
         branches: &branches,
         coalescences: &marks,
@@ -129,7 +209,17 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
         &spec,
     )
     .map_err(|e| RunError::Io(format!("drawing failed: {e}")))?;
-    let out = stage.commit()?;
+    Ok(())
+}
+
+/// The terminal lines (or with `json` the JSON document) of a sweep.
+pub fn report(
+    name: &str,
+    param: &str,
+    sw: &Sweep,
+    out: &std::path::Path,
+    json: bool,
+) -> Result<(), RunError> {
     let onsets: Vec<_> = sw
         .onsets
         .iter()
@@ -143,9 +233,9 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
             })
         })
         .collect();
-    if a.json {
+    if json {
         let doc = json!({
-            "param": axis.name,
+            "param": param,
             "points": sw.values.len(),
             "modes": sw.listed.len(),
             "onsets": onsets,
@@ -159,10 +249,10 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
     }
     crate::outln!(
         "{}: {} modes over {} values of {} → {}",
-        sc.name,
+        name,
         sw.listed.len(),
         sw.values.len(),
-        axis.name,
+        param,
         out.display()
     );
     if sw.onsets.is_empty() {
@@ -177,7 +267,7 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
         };
         crate::outln!(
             "  {} = {:.10e}: {what} ({:.2} Hz{})",
-            axis.name,
+            param,
             o.value,
             o.freq_hz,
             o.mode
