@@ -735,3 +735,52 @@ fn merge_refuses_bad_sweep_shards() {
         "--shard 0/47: more shards than the 46 values",
     );
 }
+
+#[test]
+fn slurm_sweep_scripts_run_as_an_array_and_merge() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    squeal(dir, &with(&SWEEP_HOFFMANN, &["--out", "full"]));
+    let mut args = vec!["slurm"];
+    args.extend(&SWEEP_HOFFMANN);
+    args.extend(["--tasks", "3", "--out", "merged"]);
+    squeal(dir, &args);
+    let array = std::fs::read_to_string(dir.join("merged-slurm/array.sh")).unwrap();
+    assert!(
+        array.contains(
+            "sweep hoffmann --set c1=0 --set c2=0 --param mu=0.05:0.5:46 --shard \"$K/3\""
+        ),
+        "{array}"
+    );
+    for k in 0..3 {
+        let o = Command::new("bash")
+            .current_dir(dir)
+            .arg(dir.join("merged-slurm/array.sh"))
+            .env("SLURM_ARRAY_TASK_ID", k.to_string())
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let o = Command::new("bash")
+        .current_dir(dir)
+        .arg(dir.join("merged-slurm/merge.sh"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["sweep.csv", "sweep.png", "sweep.svg"] {
+        let a = std::fs::read(dir.join("full").join(f)).unwrap();
+        let b = std::fs::read(dir.join("merged").join(f)).unwrap();
+        assert!(a == b, "{f}");
+    }
+    let mut args = vec!["slurm"];
+    args.extend(&SWEEP_HOFFMANN);
+    args.extend(["--tasks", "47", "--out", "merged2"]);
+    let out = squeal_raw(dir, &args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--tasks 47: more tasks than the 46 values"),
+        "{err}"
+    );
+    assert!(!dir.join("merged2-slurm").exists());
+}

@@ -1,4 +1,4 @@
-//! `squeal slurm map|reproduce … --tasks N [--partition P] [--time T]
+//! `squeal slurm map|reproduce|sweep … --tasks N [--partition P] [--time T]
 //! [--cpus-per-task C] [--jobs DIR] [--submit]`: a SLURM job array that
 //! computes a map (or the thesis's 40 sets) in N shards, and a merge job
 //! that depends on it.
@@ -19,6 +19,7 @@
 
 use crate::commands::map::{prepare, MapArgs};
 use crate::commands::reproduce::ReproduceArgs;
+use crate::commands::sweep::SweepArgs;
 use crate::run::{RunError, Staging};
 use clap::{Args, Subcommand};
 use squeal_study::scenario::InputError;
@@ -33,6 +34,18 @@ pub enum SlurmCmd {
     /// The thesis re-done (`squeal reproduce`) as a job array of shards of
     /// its 40 sets and a dependent merge job that writes the report.
     Reproduce(SlurmReproduceArgs),
+    /// An eigenvalue sweep (`squeal sweep`) as a job array of contiguous
+    /// slices and a dependent merge job.
+    Sweep(SlurmSweepArgs),
+}
+
+/// Arguments of `squeal slurm sweep`: those of `sweep` and the job's.
+#[derive(Args, Debug)]
+pub struct SlurmSweepArgs {
+    #[command(flatten)]
+    sweep: SweepArgs,
+    #[command(flatten)]
+    job: JobArgs,
 }
 
 /// Arguments of `squeal slurm map`: those of `map` and the job's.
@@ -128,6 +141,16 @@ fn map_args(a: &MapArgs) -> Vec<String> {
     v
 }
 
+/// The `squeal sweep …` arguments that fix the study (not --out, --shard, --json).
+fn sweep_args(a: &SweepArgs) -> Vec<String> {
+    let mut v = vec!["sweep".to_string(), a.scenario.scenario.clone()];
+    for s in &a.scenario.sets {
+        v.extend(["--set".into(), s.clone()]);
+    }
+    v.extend(["--param".into(), a.param.clone()]);
+    v
+}
+
 /// The `squeal reproduce …` arguments that fix the study (not --out, --shard).
 fn reproduce_args(a: &ReproduceArgs) -> Vec<String> {
     let mut v = vec![
@@ -199,6 +222,28 @@ pub fn run(cmd: SlurmCmd) -> Result<(), RunError> {
                 &what,
                 &head,
             )
+        }
+        SlurmCmd::Sweep(a) => {
+            check_job(&a.job, a.sweep.shard.is_some(), "sweep")?;
+            let sc = crate::commands::simulate::resolve(&a.sweep.scenario)?;
+            let p = squeal_study::map::parse_axis(&a.sweep.param, "--param", false, &sc.model)?;
+            if a.job.tasks > p.values.len() {
+                return Err(InputError(format!(
+                    "--tasks {}: more tasks than the {} values of --param {}",
+                    a.job.tasks,
+                    p.values.len(),
+                    a.sweep.param
+                ))
+                .into());
+            }
+            let out = a
+                .sweep
+                .out
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("out").join(format!("{}-sweep", sc.name)));
+            let what = format!("{} sweep of {} values", sc.name, p.values.len());
+            let head = format!("{}: {} values", sc.name, p.values.len());
+            scripts(&a.job, "sweep", &sweep_args(&a.sweep), &out, &what, &head)
         }
     }
 }

@@ -21,22 +21,22 @@ use std::path::PathBuf;
 #[derive(Args, Debug)]
 pub struct SweepArgs {
     #[command(flatten)]
-    scenario: ScenarioArgs,
+    pub scenario: ScenarioArgs,
     /// The swept parameter and its grid, e.g. mu=0.1:0.5:81 (N points, ends included).
     #[arg(long, value_name = "NAME=LO:HI:N", allow_hyphen_values = true)]
-    param: String,
+    pub param: String,
     /// Output folder (default: out/SCENARIO-sweep).
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub out: Option<PathBuf>,
     /// Print the onsets and coalescences as JSON on stdout.
     #[arg(long)]
-    json: bool,
+    pub json: bool,
     /// Compute only shard K of N (K from 0): the K-th of N contiguous
     /// slices of the values (and the two values before it, to track the
     /// modes across the boundary), written as `shard.json` + `part.json`
     /// for `squeal merge`.
     #[arg(long, value_name = "K/N")]
-    shard: Option<String>,
+    pub shard: Option<String>,
 }
 
 fn num(x: f64) -> String {
