@@ -115,7 +115,7 @@ pub mod shard {
     }
 
     /// The part of slice `k` of `n` from the sweep `sw` of its computed
-    /// values `values[computed]` (see [`slice`]).
+    /// values `values[computed]` (see [`slice()`]).
     pub fn part_of(values: &[f64], k: usize, n: usize, sw: &Sweep) -> Part {
         let (own, computed) = slice(values.len(), k, n);
         let local = &values[computed.clone()];
