@@ -318,7 +318,7 @@ struct DenseField {
     off: Vec<(usize, usize, f64)>,
     /// `M⁻¹` when it is diagonal (else zero).
     inv_mass: Row,
-    /// No ramped force, no off-diagonal entry, a diagonal `M⁻¹`: the
+    /// Plain: no ramped force, no off-diagonal entry, a diagonal `M⁻¹`: the
     /// force is `f0 + kd·q + cd·q̇` and the contacts', then scaled by `inv_mass`.
     plain: bool,
     /// Per contact (in order), its combinations as dense rows.
@@ -910,6 +910,16 @@ impl Lumped {
         });
     }
 
+    /// `F_n` of a contact that touches, from its folded rows.
+    #[inline(always)]
+    fn normal_folded(c: &Contact, fc: &FoldedContact, q: &[f64], u: &[f64]) -> f64 {
+        let n = q.len();
+        match c.normal {
+            Normal::Elastic { .. } => dot_from(dot(&fc.fn_q[..n], q), &fc.fn_u[..n], u),
+            Normal::Prescribed(f) => f,
+        }
+    }
+
     /// Add the force of contact `c` in `mode` to `acc` (its normal force,
     /// and in slip its friction and follower force), from its folded rows
     /// `fc`; `true` if it sticks (its friction force is a multiplier).
@@ -926,10 +936,7 @@ impl Lumped {
         if mode == Mode::Free {
             return false;
         }
-        let f_n = match c.normal {
-            Normal::Elastic { .. } => dot_from(dot(&fc.fn_q[..n], q), &fc.fn_u[..n], u),
-            Normal::Prescribed(f) => f,
-        };
+        let f_n = Self::normal_folded(c, fc, q, u);
         if mode == Mode::Stick {
             // (A prescribed load's normal row is zero: `a − F_n·0 = a`.)
             for (a, x) in acc.iter_mut().zip(&fc.normal[..n]) {
@@ -937,14 +944,11 @@ impl Lumped {
             }
             return true;
         }
-        // s·μ(s·v)·F_n with s = ±1 applied as a negation (the same bits).
         let v = c.v + dot(&fc.tangent[..n], u);
         let f_nf = if fc.bilateral { f_n.max(0.0) } else { f_n };
-        let f_t = if mode == Mode::SlipPos {
-            c.friction.mu(v) * f_nf
-        } else {
-            -c.friction.mu(-v) * f_nf
-        };
+        // s·μ(s·v)·F_n: one call of the law (so that it stays inline); s = ±1 is exact.
+        let s = mode.slip_sign();
+        let f_t = s * c.friction.mu(s * v) * f_nf;
         for ((a, x), y) in acc.iter_mut().zip(&fc.normal[..n]).zip(&fc.tangent[..n]) {
             *a = *a - f_n * x - f_t * y;
         }
@@ -1016,6 +1020,29 @@ impl Lumped {
             let mut f = [0.0; N];
             f[..n].copy_from_slice(acc);
             self.apply_inv_mass(&f[..n], acc);
+        }
+    }
+
+    /// The right-hand side of any model: on the folded operators up to
+    /// [`DENSE_FIELD_DOFS`] dofs, else on the elements.
+    #[inline(never)]
+    fn field_general<const N: usize>(
+        &self,
+        t: f64,
+        modes: &Modes,
+        z: &[f64; N],
+        dz: &mut [f64; N],
+    ) {
+        match &self.dense {
+            Some(d) if N / 2 <= DENSE_FIELD_DOFS => self.field_folded(d, t, modes, z, dz),
+            _ => {
+                let n = N / 2;
+                let (q, u) = z.split_at(n);
+                let mut acc = [0.0; N];
+                self.force(t, modes, q, u, &mut acc[..n]);
+                dz[..n].copy_from_slice(u);
+                self.apply_inv_mass(&acc[..n], &mut dz[n..]);
+            }
         }
     }
 
@@ -1797,19 +1824,22 @@ impl<const N: usize> System<N> for Lumped {
         &self.contacts[i].name
     }
 
+    /// The commonest small model (plain, one contact) inline in the
+    /// integrator's stages; every other model through [`Lumped::field_general`]
+    /// (one out-of-line copy, so that the stages stay compact).
     #[inline(always)]
     fn field(&self, t: f64, modes: &Modes, z: &[f64; N], dz: &mut [f64; N]) {
         match &self.dense {
             // (The size test is a constant of each compiled size.)
-            Some(d) if N / 2 <= DENSE_FIELD_DOFS => self.field_folded(d, t, modes, z, dz),
-            _ => {
-                let n = N / 2;
-                let (q, u) = z.split_at(n);
-                let mut acc = [0.0; N];
-                self.force(t, modes, q, u, &mut acc[..n]);
-                dz[..n].copy_from_slice(u);
-                self.apply_inv_mass(&acc[..n], &mut dz[n..]);
+            Some(d)
+                if N / 2 <= DENSE_FIELD_DOFS
+                    && d.plain
+                    && d.contacts.len() == 1
+                    && self.contacts.len() == 1 =>
+            {
+                self.field_folded(d, t, modes, z, dz)
             }
+            _ => self.field_general(t, modes, z, dz),
         }
     }
 
