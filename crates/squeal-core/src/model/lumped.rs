@@ -2084,7 +2084,11 @@ impl<const N: usize> System<N> for Lumped {
         self.observe_dyn(t, modes, z, i)
     }
 
+    #[inline]
     fn breakpoint_after(&self, t: f64) -> Option<f64> {
+        if !self.has_ramp {
+            return None;
+        }
         self.forces
             .iter()
             .filter(|f| f.ramp > 0.0 && t < f.ramp)
@@ -2214,6 +2218,7 @@ impl<const N: usize> System<N> for Fixed<'_, N> {
     fn observe_contact(&self, t: f64, modes: &Modes, z: &[f64; N], i: usize) -> Observables {
         self.0.observe_dyn(t, modes, z, i)
     }
+    #[inline]
     fn breakpoint_after(&self, t: f64) -> Option<f64> {
         <Lumped as System<N>>::breakpoint_after(self.0, t)
     }
