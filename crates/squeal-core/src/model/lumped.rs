@@ -946,9 +946,11 @@ impl Lumped {
         }
         let v = c.v + dot(&fc.tangent[..n], u);
         let f_nf = if fc.bilateral { f_n.max(0.0) } else { f_n };
-        // s·μ(s·v)·F_n: one call of the law (so that it stays inline); s = ±1 is exact.
-        let s = mode.slip_sign();
-        let f_t = s * c.friction.mu(s * v) * f_nf;
+        // s·μ(s·v)·F_n with s = ±1 applied as negations (the same bits, no
+        // multiplications on the critical path), one call of the law (inline).
+        let pos = mode == Mode::SlipPos;
+        let mu = c.friction.mu(if pos { v } else { -v });
+        let f_t = if pos { mu * f_nf } else { -mu * f_nf };
         for ((a, x), y) in acc.iter_mut().zip(&fc.normal[..n]).zip(&fc.tangent[..n]) {
             *a = *a - f_n * x - f_t * y;
         }
