@@ -920,6 +920,24 @@ impl Lumped {
         }
     }
 
+    /// The friction force `F_t = s·μ(s·v)·F_n` (`F_n⁺` for a bilateral
+    /// layer) of a contact in slip mode `mode`, from its folded rows.
+    #[inline(always)]
+    fn slip_folded(c: &Contact, fc: &FoldedContact, mode: Mode, f_n: f64, u: &[f64]) -> f64 {
+        let n = u.len();
+        let v = c.v + dot(&fc.tangent[..n], u);
+        let f_nf = if fc.bilateral { f_n.max(0.0) } else { f_n };
+        // s = ±1 applied as negations (the same bits, no multiplications on
+        // the critical path), one call of the law (so that it stays inline).
+        let pos = mode == Mode::SlipPos;
+        let mu = c.friction.mu(if pos { v } else { -v });
+        if pos {
+            mu * f_nf
+        } else {
+            -mu * f_nf
+        }
+    }
+
     /// Add the force of contact `c` in `mode` to `acc` (its normal force,
     /// and in slip its friction and follower force), from its folded rows
     /// `fc`; `true` if it sticks (its friction force is a multiplier).
@@ -944,13 +962,7 @@ impl Lumped {
             }
             return true;
         }
-        let v = c.v + dot(&fc.tangent[..n], u);
-        let f_nf = if fc.bilateral { f_n.max(0.0) } else { f_n };
-        // s·μ(s·v)·F_n with s = ±1 applied as negations (the same bits, no
-        // multiplications on the critical path), one call of the law (inline).
-        let pos = mode == Mode::SlipPos;
-        let mu = c.friction.mu(if pos { v } else { -v });
-        let f_t = if pos { mu * f_nf } else { -mu * f_nf };
+        let f_t = Self::slip_folded(c, fc, mode, f_n, u);
         for ((a, x), y) in acc.iter_mut().zip(&fc.normal[..n]).zip(&fc.tangent[..n]) {
             *a = *a - f_n * x - f_t * y;
         }
@@ -997,6 +1009,27 @@ impl Lumped {
             }
             for &(r, c, v) in &d.off {
                 acc[r] += v * z[c];
+            }
+        }
+        // A plain model with one contact in slip: the contact's forces and
+        // M⁻¹ in one pass (the same operations, one store per dof).
+        if let (true, [c], [fc]) = (d.plain, &self.contacts[..], &d.contacts[..]) {
+            let mode = modes.first();
+            if mode == Mode::SlipPos || mode == Mode::SlipNeg {
+                let f_n = Self::normal_folded(c, fc, q, u);
+                let f_t = Self::slip_folded(c, fc, mode, f_n, u);
+                let (nrm, tan, inv) = (&fc.normal[..n], &fc.tangent[..n], &d.inv_mass[..n]);
+                if c.alpha != 0.0 {
+                    let f_f = c.alpha * f_t * dot(&fc.slope[..n], q);
+                    for i in 0..n {
+                        acc[i] = (acc[i] - f_n * nrm[i] - f_t * tan[i] + f_f * nrm[i]) * inv[i];
+                    }
+                } else {
+                    for i in 0..n {
+                        acc[i] = (acc[i] - f_n * nrm[i] - f_t * tan[i]) * inv[i];
+                    }
+                }
+                return;
             }
         }
         // One contact (the commonest case) without the loop's machinery.
