@@ -344,10 +344,16 @@ struct FoldedContact {
 }
 
 /// `Σ a_i·b_i` summed in index order (the terms with a zero coefficient add
-/// an exact zero, so the sum equals the sum over the non-zero terms).
+/// an exact zero, so the sum equals the sum over the non-zero terms),
+/// starting from the first product rather than from `0 + a_0·b_0` (one
+/// addition less on the critical path; only the sign of an all-zero sum can
+/// differ).
 #[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
-    dot_from(0.0, a, b)
+    match (a.split_first(), b.split_first()) {
+        (Some((x, a)), Some((y, b))) => dot_from(x * y, a, b),
+        _ => 0.0,
+    }
 }
 
 /// `s + Σ a_i·b_i`, added in index order.
