@@ -1866,7 +1866,7 @@ impl<const N: usize> System<N> for Lumped {
     }
 
     /// The commonest small model (plain, one contact) inline in the
-    /// integrator's stages; every other model through [`Lumped::field_general`]
+    /// integrator's stages; every other model through `Lumped::field_general`
     /// (one out-of-line copy, so that the stages stay compact).
     #[inline(always)]
     fn field(&self, t: f64, modes: &Modes, z: &[f64; N], dz: &mut [f64; N]) {
