@@ -922,6 +922,12 @@ fn folded_field_equals_the_element_loops() {
     for (label, spec, pos, vel) in [
         ("follower", follower, 1e-6, 0.5),
         ("plain", plain, 1e-6, 0.5),
+        (
+            "plain without follower",
+            disc_pad_spec(&DiscPad::default()),
+            1e-6,
+            0.5,
+        ),
         ("plain bilateral", plain_bilateral, 1e-6, 0.5),
         ("two-pad bilateral", bilateral, 1e-6, 0.5),
         ("belt with M, K", belt, 1e-2, 0.5),
