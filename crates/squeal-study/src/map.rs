@@ -302,7 +302,7 @@ fn transient_point<M: System<N>, const N: usize>(
         z0,
         sc.duration,
         sc.sample_rate,
-        sc.solver,
+        crate::run::sim_options::<N>(sc),
         &mut w,
     )
     .map_err(|e| e.to_string())?;
@@ -372,7 +372,7 @@ pub fn transient_at(sc: &Scenario, x: &Axis, y: &Axis, k: usize) -> Outcome {
         // Each point gets its own step budget (its stiffness differs).
         .and_then(|_| crate::feasible::prepare(&mut s).map_err(|e| e.to_string()))
         .and_then(|_| {
-            crate::with_system!(&s.model, m => transient_point(m, &s),
+            crate::with_sim_system!(&s.model, m => transient_point(m, &s),
             else => Err(s.model.check_simulable().err().unwrap_or_default()))
         });
     r.unwrap_or(Outcome::FAILED)
