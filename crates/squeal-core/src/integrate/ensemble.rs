@@ -52,8 +52,9 @@ pub struct Job<'m, M: System<N> + ?Sized, S: Sink<N>, const N: usize> {
 /// The contract is [`System::field`]'s, lane by lane and bit for bit: each
 /// lane's slope must come from the same IEEE operations in the same order as
 /// `field` on that lane's model, state and time (lane-wise products, sums
-/// and quotients of [`f64x4`] are the scalar ones). A call may decline
-/// (`false`): then each lane is evaluated by [`System::field`].
+/// and quotients of [`f64x4`] are the scalar ones). A call may leave lanes
+/// out (e.g. a mode it does not cover): those lanes are then evaluated by
+/// [`System::field`].
 pub trait LaneField<const N: usize>: System<N> + Sized {
     /// What the lane-wise field needs of the lanes' models, gathered once
     /// per change of the lanes' jobs (not on every call).
@@ -63,15 +64,16 @@ pub trait LaneField<const N: usize>: System<N> + Sized {
     /// [`System::field`]).
     fn pack(models: [Option<&Self>; LANES]) -> Option<Self::Pack>;
     /// `dz = f(t, z)` lane by lane, each lane in its own `modes`
-    /// (`None`: an idle lane, whose `dz` is not used). Returns `false`,
-    /// `dz` untouched, if some lane's modes cannot be done lane-wise.
+    /// (`None`: an idle lane, whose `dz` is not used). Returns the lanes it
+    /// computed; the others' `dz` may hold anything (they are computed
+    /// again by [`System::field`]).
     fn field_lanes(
         pack: &Self::Pack,
         t: f64x4,
         modes: &[Option<Modes>; LANES],
         z: &[f64x4; N],
         dz: &mut [f64x4; N],
-    ) -> bool;
+    ) -> [bool; LANES];
 }
 
 /// How the lanes' slopes are computed: one model call per lane
@@ -79,14 +81,15 @@ pub trait LaneField<const N: usize>: System<N> + Sized {
 trait Slopes<M: System<N> + ?Sized, const N: usize> {
     /// The lanes' jobs changed: gather what the lane-wise field needs.
     fn repack(&mut self, lanes: &[Option<Lane<'_, M, N>>; L]);
-    /// Every masked lane's slope at `(t, z)` in `dz`; `false` if declined.
+    /// The slopes at `(t, z)` of the lanes with `modes` in `dz`; returns
+    /// the lanes computed (the others are left to [`System::field`]).
     fn lanes(
         &self,
         t: f64x4,
         modes: &[Option<Modes>; L],
         z: &[f64x4; N],
         dz: &mut [f64x4; N],
-    ) -> bool;
+    ) -> [bool; L];
 }
 
 /// Every lane's slope by its own model call.
@@ -101,8 +104,8 @@ impl<M: System<N> + ?Sized, const N: usize> Slopes<M, N> for PerLane {
         _modes: &[Option<Modes>; L],
         _z: &[f64x4; N],
         _dz: &mut [f64x4; N],
-    ) -> bool {
-        false
+    ) -> [bool; L] {
+        [false; L]
     }
 }
 
@@ -122,10 +125,10 @@ impl<M: LaneField<N>, const N: usize> Slopes<M, N> for Packed<M, N> {
         modes: &[Option<Modes>; L],
         z: &[f64x4; N],
         dz: &mut [f64x4; N],
-    ) -> bool {
+    ) -> [bool; L] {
         match &self.0 {
             Some(pack) => M::field_lanes(pack, t, modes, z, dz),
-            None => false,
+            None => [false; L],
         }
     }
 }
@@ -407,32 +410,30 @@ impl<const N: usize> Soa<N> {
             (Some(lane), true) => Some(lane.solver.modes),
             _ => None,
         });
-        if f.lanes(tc, &modes, y, &mut self.k[s]) {
-            for (l, lane) in lanes.iter_mut().enumerate() {
-                if let (Some(lane), true) = (lane, mask[l]) {
-                    lane.solver.stats.rhs_evals += 1;
-                }
-            }
-            return;
-        }
+        let done = f.lanes(tc, &modes, y, &mut self.k[s]);
         let h = self.h.to_array();
-        let mut out = [[0.0; N]; L];
         for (l, lane) in lanes.iter_mut().enumerate() {
             if let (Some(lane), true) = (lane, mask[l]) {
                 let solver = &mut lane.solver;
                 solver.stats.rhs_evals += 1;
+                if done[l] {
+                    continue;
+                }
                 let tc = if s == 12 {
                     self.t[l] + h[l]
                 } else {
                     self.t[l] + c * h[l]
                 };
+                let mut out = [0.0; N];
                 solver
                     .model
-                    .field(tc, &solver.modes, &lane_of(y, l), &mut out[l]);
+                    .field(tc, &solver.modes, &lane_of(y, l), &mut out);
+                for i in 0..N {
+                    let mut v = self.k[s][i].to_array();
+                    v[l] = out[i];
+                    self.k[s][i] = f64x4::new(v);
+                }
             }
-        }
-        for i in 0..N {
-            self.k[s][i] = f64x4::new(std::array::from_fn(|l| out[l][i]));
         }
     }
 

@@ -574,10 +574,10 @@ pub struct DiscPadLanes {
 }
 
 /// Lane-wise [`Model::rhs`] in slip (either sign) with the thesis friction
-/// law and unilateral contact — the default run and every transient map
-/// point until its first reversal; any other law, contact or mode declines,
-/// and those lanes are evaluated one by one. Each lane's slope comes from
-/// the same operations, in the same order, as `rhs` (tested bit for bit).
+/// law and unilateral contact (the default; any other law or contact: no
+/// pack, every lane one by one). Lanes in stick or free flight are left to
+/// `rhs`. Each lane's slope comes from the same operations, in the same
+/// order, as `rhs` (tested bit for bit).
 impl LaneField<8> for DiscPad {
     type Pack = DiscPadLanes;
 
@@ -627,14 +627,18 @@ impl LaneField<8> for DiscPad {
         modes: &[Option<Modes>; LANES],
         z: &[f64x4; 8],
         dz: &mut [f64x4; 8],
-    ) -> bool {
+    ) -> [bool; LANES] {
         let mut neg = [0.0; LANES];
+        let mut done = [false; LANES];
         for (l, m) in modes.iter().enumerate() {
             match m.map(|m| m.first()) {
-                None | Some(Mode::SlipPos) => {}
-                Some(Mode::SlipNeg) => neg[l] = 1.0,
-                Some(_) => return false,
+                Some(Mode::SlipPos) => done[l] = true,
+                Some(Mode::SlipNeg) => (neg[l], done[l]) = (1.0, true),
+                _ => {}
             }
+        }
+        if !done.contains(&true) {
+            return done;
         }
         let zero = f64x4::ZERO;
         let neg = f64x4::new(neg).cmp_gt(zero);
@@ -659,6 +663,6 @@ impl LaneField<8> for DiscPad {
         dz[UP] = (p.neg_k_px * z[XP] - p.c_px * z[UP] + f_t) * p.inv_mp;
         dz[WD] = (p.neg_k_dy * z[YD] - p.c_dy * z[WD] - f_y + f_f) * p.inv_md;
         dz[WP] = (f_y - load - f_f) * p.inv_mp;
-        true
+        done
     }
 }
