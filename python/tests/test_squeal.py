@@ -156,6 +156,12 @@ def test_critical_none_when_nothing_crosses(cli):
     assert (c["param"], c["value"], c["freq_hz"]) == ("V", None, None)
 
 
+def test_critical_refuses_a_grid_out_of_range():
+    for grid in (1, 100_001):
+        with pytest.raises(squeal.ScenarioError, match=f"--grid {grid}: must be between 2 and 100000"):
+            squeal.critical("hoffmann", param=("mu", 0.0, 1.0), grid=grid)
+
+
 def test_sweep_shapes():
     sw = squeal.sweep(param=("c_px", 0.05, 0.5, 11))
     assert sw["eigenvalues"].shape == (11, 8) and sw["eigenvalues"].dtype == np.complex128

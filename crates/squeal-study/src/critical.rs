@@ -8,6 +8,9 @@ use crate::model::AnyModel;
 use crate::scenario::InputError;
 use squeal_core::stability::{self, CriticalOptions, Crossing, StabilityError};
 
+/// Most points of `critical`'s initial scan (about a second of eigen-analyses).
+pub const MAX_GRID: usize = 100_000;
+
 /// Both ends of a range must be values the parameter may take: the reason
 /// the one that is not cannot, naming it (LO or HI).
 pub fn check_endpoints(model: &AnyModel, name: &str, lo: f64, hi: f64) -> Result<(), String> {
@@ -39,6 +42,12 @@ pub fn locate(
     grid: usize,
     cancel: &Cancel,
 ) -> Result<Option<Crossing>, StudyError> {
+    if !(2..=MAX_GRID).contains(&grid) {
+        return Err(InputError(format!(
+            "--grid {grid}: must be between 2 and {MAX_GRID} (the scan, then Brent's method, locates the crossing to 1e-10 whatever the grid)"
+        ))
+        .into());
+    }
     if model.get(name).is_none() {
         return Err(InputError(format!(
             "--param {name}: unknown parameter for model {}",

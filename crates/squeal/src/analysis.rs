@@ -111,13 +111,19 @@ pub fn si_scale(max_abs: f64) -> (f64, &'static str) {
 }
 
 /// Words for a velocity column: "pad tangential" for `vx_p`.
-fn velocity_words(v: &str) -> String {
+fn velocity_words(v: &str) -> Option<&'static str> {
     let pos = if v == "v" {
         "x"
     } else {
         v.strip_prefix('v').unwrap_or(v)
     };
-    squeal_study::model::coordinate_words(pos).map_or(v.to_string(), str::to_string)
+    squeal_study::model::coordinate_words(pos)
+}
+
+/// `" (words)"` for a velocity with known words (`" (disc tangential)"`), else
+/// nothing: a lumped model's dof names are already the user's own words.
+fn velocity_words_paren(v: &str) -> String {
+    velocity_words(v).map_or(String::new(), |w| format!(" ({w})"))
 }
 
 /// Frequencies shown: (divisor, unit) — kHz when the shown range reaches 2 kHz.
@@ -160,11 +166,10 @@ pub fn draw(
             let m = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             let (k, p) = si_scale(m);
             Some(Shown {
-                title: format!(
-                    "{title}: {} velocity {}",
-                    velocity_words(&c.signal),
-                    c.signal
-                ),
+                title: match velocity_words(&c.signal) {
+                    Some(w) => format!("{title}: {w} velocity {}", c.signal),
+                    None => format!("{title}: velocity {}", c.signal),
+                },
                 y_label: format!("velocity ({p}m/s)"),
                 y: x.iter().map(|v| v / k).collect(),
             })
@@ -200,12 +205,18 @@ pub fn draw(
                 })
                 .collect();
             Spec {
-                title: format!(
-                    "{what} of {} ({}, {} window)",
-                    c.signal,
-                    velocity_words(&c.signal),
-                    c.spectrum.window.name()
-                ),
+                title: match velocity_words(&c.signal) {
+                    Some(w) => format!(
+                        "{what} of {} ({w}, {} window)",
+                        c.signal,
+                        c.spectrum.window.name()
+                    ),
+                    None => format!(
+                        "{what} of {} ({} window)",
+                        c.signal,
+                        c.spectrum.window.name()
+                    ),
+                },
                 y_label: if c.spectrum.scaling == Scaling::Amplitude {
                     "amplitude (dB re 1 m/s)"
                 } else {
@@ -261,8 +272,8 @@ pub fn draw(
             squeal_signal::window::Window::Hann,
         ) {
             let title = format!(
-                "{title}: spectrogram of {sg_signal} ({})",
-                velocity_words(&sg_signal)
+                "{title}: spectrogram of {sg_signal}{}",
+                velocity_words_paren(&sg_signal)
             );
             let rows: Vec<usize> = (0..sg.n_freqs())
                 .filter(|&k| {
@@ -326,10 +337,10 @@ pub fn draw(
         let (kv, ppv) = si_scale(vm);
         let xs: Vec<f64> = x.iter().map(|a| (a - mean) / kx).collect();
         let vs: Vec<f64> = v.iter().map(|a| a / kv).collect();
-        let title = format!(
-            "{title}: phase portrait of {} ({px} – {pv}), t ≥ {t_from:.3} s",
-            velocity_words(&pv)
-        );
+        let title = match velocity_words(&pv) {
+            Some(w) => format!("{title}: phase portrait of {w} ({px} – {pv}), t ≥ {t_from:.3} s"),
+            None => format!("{title}: phase portrait of {px} – {pv}, t ≥ {t_from:.3} s"),
+        };
         let x_label = format!(
             "{px} − mean ({}, mean {})",
             format_args!("{ppx}m"),

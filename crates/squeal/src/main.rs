@@ -136,11 +136,20 @@ fn usage_error(e: clap::Error) -> ExitCode {
     let text = e.render().to_string();
     let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
     let first = lines.next().unwrap_or("error: bad command line");
-    let first = if first.starts_with("error:") {
+    let mut first = if first.starts_with("error:") {
         first.to_string()
     } else {
         format!("error: {first}")
     };
+    // "the following required arguments were not provided:" lists them on
+    // the next lines: keep them on the one line.
+    if first.ends_with(':') {
+        let listed: Vec<&str> = lines
+            .clone()
+            .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("tip:"))
+            .collect();
+        first = format!("{first} {}", listed.join(", "));
+    }
     match lines.find(|l| l.starts_with("tip:")) {
         Some(tip) => eprintln!("{first} ({tip}; see --help)"),
         None => eprintln!("{first} (see --help)"),

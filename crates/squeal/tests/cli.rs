@@ -369,3 +369,18 @@ fn output_folder_guards_user_data() {
     let series = read(d.path().join("run/series.csv"));
     assert_eq!(series.lines().count(), 1 + 201);
 }
+
+/// A missing required flag is named on the one line of the error.
+#[test]
+fn missing_required_flags_are_named() {
+    let d = tmp();
+    let out = squeal(d.path(), &["branch", "belt"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("--param <NAME=LO:HI:N>") && err.contains("--out <OUT>"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 0);
+}

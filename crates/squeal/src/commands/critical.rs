@@ -27,8 +27,6 @@ pub struct CriticalArgs {
     json: bool,
 }
 
-/// Most points of `critical`'s initial scan (about a second of eigen-analyses).
-pub const MAX_GRID: usize = 100_000;
 
 /// Parse `NAME=LO:HI`.
 pub fn parse_interval(spec: &str, flag: &str) -> Result<(String, f64, f64), InputError> {
@@ -53,13 +51,6 @@ pub fn parse_interval(spec: &str, flag: &str) -> Result<(String, f64, f64), Inpu
 pub fn run(a: CriticalArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
     let (name, lo, hi) = parse_interval(&a.param, "--param")?;
-    if !(2..=MAX_GRID).contains(&a.grid) {
-        return Err(InputError(format!(
-            "--grid {}: must be between 2 and {MAX_GRID} (the scan, then Brent's method, locates the crossing to 1e-10 whatever the grid)",
-            a.grid
-        ))
-        .into());
-    }
     let found = locate(&sc.model, &name, lo, hi, a.grid, &crate::run::NEVER)?;
     if a.json {
         let mut doc = match &found {
