@@ -412,6 +412,8 @@ impl<const N: usize> Soa<N> {
         });
         let done = f.lanes(tc, &modes, y, &mut self.k[s]);
         let h = self.h.to_array();
+        let mut out = [[0.0; N]; L];
+        let mut rest = [false; L];
         for (l, lane) in lanes.iter_mut().enumerate() {
             if let (Some(lane), true) = (lane, mask[l]) {
                 let solver = &mut lane.solver;
@@ -419,20 +421,29 @@ impl<const N: usize> Soa<N> {
                 if done[l] {
                     continue;
                 }
+                rest[l] = true;
                 let tc = if s == 12 {
                     self.t[l] + h[l]
                 } else {
                     self.t[l] + c * h[l]
                 };
-                let mut out = [0.0; N];
                 solver
                     .model
-                    .field(tc, &solver.modes, &lane_of(y, l), &mut out);
-                for i in 0..N {
-                    let mut v = self.k[s][i].to_array();
-                    v[l] = out[i];
-                    self.k[s][i] = f64x4::new(v);
-                }
+                    .field(tc, &solver.modes, &lane_of(y, l), &mut out[l]);
+            }
+        }
+        // The lanes evaluated one by one go in with one vector per state
+        // (not lane by lane: a vector rebuilt from four scalar stores).
+        if rest.contains(&true) {
+            for i in 0..N {
+                let done_i = self.k[s][i].to_array();
+                self.k[s][i] = f64x4::new(std::array::from_fn(|l| {
+                    if rest[l] {
+                        out[l][i]
+                    } else {
+                        done_i[l]
+                    }
+                }));
             }
         }
     }

@@ -27,7 +27,6 @@ pub struct CriticalArgs {
     json: bool,
 }
 
-
 /// Parse `NAME=LO:HI`.
 pub fn parse_interval(spec: &str, flag: &str) -> Result<(String, f64, f64), InputError> {
     let bad = || {
