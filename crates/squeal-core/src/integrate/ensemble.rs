@@ -8,13 +8,16 @@
 //! layout (`[stage][state][lane]`) whose innermost loop runs across lanes.
 //! Each lane's numbers go through the same operations in the same order as
 //! in a run of its own, so the ensemble's results are bit-for-bit those of
-//! one-at-a-time runs. What it could gain: the lanes' right-hand sides are
+//! one-at-a-time runs. What it gains: the lanes' right-hand sides are
 //! independent, so the processor overlaps their latencies, which a single
-//! trajectory's serial chain of stages cannot do. Measured (BENCHMARKS.md,
-//! issue 16): 11 % slower per run than one at a time on the baseline
-//! x86-64 target, where one trajectory's 8 states already fill the 2-wide
-//! vectors and each lane's right-hand side is still called on its own;
-//! 5 % faster for x86-64-v3. Not used by the CLI for that reason.
+//! trajectory's serial chain of stages cannot do, and with AVX2 a stage
+//! combination serves four lanes per instruction. With each lane's
+//! right-hand side called on its own ([`simulate_ensemble`]) that is eaten
+//! by copying states and slopes in and out of the lanes; with a model's
+//! lane-wise [`LaneField`] ([`simulate_ensemble_lanes`]) the disc–pad runs
+//! 1.25–1.45× as many steps per CPU-second as one at a time on the default
+//! x86-64-v3 build (BENCHMARKS.md, issue 16). Transient maps of the
+//! disc–pad use it.
 //!
 //! A lane whose run ends (finished, stopped by its sink, or failed) takes
 //! the next job at once, so a sweep of many short runs keeps all lanes busy.
