@@ -33,7 +33,7 @@ pub fn check(sc: &Scenario, name: &str, values: &[f64]) -> Result<(), StudyError
         ))
         .into());
     }
-    sc.model.check_simulable().map_err(InputError)?;
+    sc.model.check_cycle_size().map_err(InputError)?;
     // i9's validation path, the part that applies to a cycle (which budgets
     // its own settling): a linearisation that overflows is named by parameter.
     crate::feasible::scales(&sc.model, Some(sc))
@@ -109,7 +109,7 @@ pub fn follow(
         };
         let b = cont::branch(&guarded, values, &mut settle, &bopts);
         Ok(collect(&b, &names))
-    }, else => Err(StudyError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))));
+    }, else => Err(StudyError::Input(InputError(sc.model.check_cycle_size().err().unwrap_or_default()))));
     cancel.check()?;
     progress.inc(values.len().saturating_sub(settled) as u64);
     let (points, curve, failures, bifurcations, ends) = out?;

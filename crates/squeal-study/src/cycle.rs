@@ -79,7 +79,7 @@ pub fn checked_options(
     if settle_steps == 0 {
         return Err(InputError("--settle-steps 0: must be at least 1".into()).into());
     }
-    sc.model.check_simulable().map_err(InputError)?;
+    sc.model.check_cycle_size().map_err(InputError)?;
     // The validation path of a simulated run, the part that applies to a
     // cycle (which budgets its own settling): a linearisation that overflows
     // is named by parameter.
@@ -215,7 +215,7 @@ pub fn of_scenario(
     let found = crate::with_system!(&sc.model, m => {
         let z0 = crate::run::initial_of(m, sc)?;
         find(m, &sc.model, &z0, None, opts, with_orbit)
-    }, else => Err(StudyError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))));
+    }, else => Err(StudyError::Input(InputError(sc.model.check_cycle_size().err().unwrap_or_default()))));
     cancel.check()?;
     found
 }

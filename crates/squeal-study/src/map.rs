@@ -345,7 +345,7 @@ fn transient_point<M: System<N>, const N: usize>(
         z0,
         sc.duration,
         sc.sample_rate,
-        sc.solver,
+        crate::run::sim_options::<N>(sc),
         &mut w,
     );
     classify(&w, info)
@@ -408,7 +408,7 @@ fn transient_chunk(sc: &Scenario, x: &Axis, y: &Axis, chunk: &[usize]) -> Vec<Ou
                 t0: 0.0,
                 z0,
                 t_end: s.duration,
-                opts: s.solver,
+                opts: crate::run::sim_options::<8>(s),
                 sink,
             });
             slots.push(*n);
@@ -438,7 +438,7 @@ fn prepared(sc: &Scenario, x: &Axis, y: &Axis, k: usize) -> Result<Scenario, Str
 
 /// The transient run of a prepared point, one at a time.
 fn run_prepared(s: &Scenario) -> Result<Outcome, String> {
-    crate::with_system!(&s.model, m => transient_point(m, s),
+    crate::with_sim_system!(&s.model, m => transient_point(m, s),
         else => Err(s.model.check_simulable().err().unwrap_or_default()))
 }
 

@@ -1,6 +1,6 @@
 //! The models the command line knows, behind one enum, with their output columns.
 
-use squeal_core::model::lumped::MAX_SIM_DOFS;
+use squeal_core::model::lumped::{MAX_EXACT_DOFS, MAX_SIM_DOFS};
 use squeal_core::model::{Modes, Observables};
 use squeal_core::params::ParamKind;
 use squeal_core::stability::{self, Analysis, Inertia, StabilityError};
@@ -49,6 +49,27 @@ macro_rules! with_system {
             $crate::model::AnyModel::Hoffmann($m) => $body,
             $crate::model::AnyModel::Lumped(l) => {
                 squeal_core::with_lumped_size!(&**l, $m => $body, else => $fallback)
+            }
+        }
+    };
+}
+
+/// As [`with_system!`](crate::with_system), for simulation only: a lumped
+/// model of more than `MAX_EXACT_DOFS` (and at most `MAX_SIM_DOFS`) dofs runs
+/// padded with idle dofs (`squeal_core::model::lumped::padding`): run it
+/// with [`crate::run::sim_options`] and [`crate::run::initial_of`], and read
+/// only its real states. Never for an eigen- or Floquet analysis (the idle
+/// dofs would add their modes).
+#[macro_export]
+macro_rules! with_sim_system {
+    ($any:expr, $m:ident => $body:expr, else => $fallback:expr) => {
+        match $any {
+            $crate::model::AnyModel::DiscPad($m) => $body,
+            $crate::model::AnyModel::Belt($m) => $body,
+            $crate::model::AnyModel::Hoffmann($m) => $body,
+            $crate::model::AnyModel::Lumped(l) => {
+                squeal_core::with_lumped_size!(&**l, $m => $body,
+                    else => squeal_core::with_padded_size!(&**l, $m => $body, else => $fallback))
             }
         }
     };
@@ -161,7 +182,19 @@ impl AnyModel {
     pub fn check_simulable(&self) -> Result<(), String> {
         match self {
             AnyModel::Lumped(l) if l.dof_count() > MAX_SIM_DOFS => Err(format!(
-                "this lumped model has {} dofs: simulation supports up to {MAX_SIM_DOFS} dofs (stability, map and critical work for any size)",
+                "this lumped model has {} dofs: simulation supports up to {MAX_SIM_DOFS} dofs (stability, map, critical and sweep work for any size)",
+                l.dof_count()
+            )),
+            _ => Ok(()),
+        }
+    }
+    /// Whether the model's limit cycles can be analysed (`cycle`, `branch`:
+    /// Floquet multipliers on fixed-size states; lumped: at most
+    /// `MAX_EXACT_DOFS` dofs).
+    pub fn check_cycle_size(&self) -> Result<(), String> {
+        match self {
+            AnyModel::Lumped(l) if l.dof_count() > MAX_EXACT_DOFS => Err(format!(
+                "this lumped model has {} dofs: cycle and branch support up to {MAX_EXACT_DOFS} dofs (simulate and map --transient up to {MAX_SIM_DOFS}; stability, map, critical and sweep any size)",
                 l.dof_count()
             )),
             _ => Ok(()),

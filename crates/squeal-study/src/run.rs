@@ -6,6 +6,7 @@ use crate::model::AnyModel;
 use crate::scenario::{InputError, Scenario};
 use squeal_core::initial::initial_state;
 use squeal_core::integrate::{Flow, Sink};
+use squeal_core::model::lumped::padding;
 use squeal_core::model::{Modes, Observables};
 use squeal_core::{simulate, EventKind, Mode, RunInfo, System};
 
@@ -56,6 +57,8 @@ struct Collect<'a, M: ?Sized> {
     model: &'a M,
     any: &'a AnyModel,
     data: Vec<Vec<f64>>,
+    /// The states written, in order (all `N`, or a padded model's real ones).
+    states: Vec<usize>,
     derived: Vec<f64>,
     obs: Vec<Observables>,
     events: Vec<(f64, EventKind)>,
@@ -74,13 +77,14 @@ impl<M: System<N> + ?Sized, const N: usize> Sink<N> for Collect<'_, M> {
     }
     fn sample_modes(&mut self, t: f64, z: &[f64; N], modes: &Modes) -> Flow {
         self.data[0].push(t);
-        for i in 0..N {
-            self.data[1 + i].push(z[i]);
+        for (col, &i) in self.data[1..].iter_mut().zip(&self.states) {
+            col.push(z[i]);
         }
         observe_all(self.model, t, modes, z, &mut self.obs);
         self.any.derived_values(&self.obs, modes, &mut self.derived);
-        for (j, v) in self.derived.iter().enumerate() {
-            self.data[1 + N + j].push(*v);
+        let first = 1 + self.states.len();
+        for (col, v) in self.data[first..].iter_mut().zip(&self.derived) {
+            col.push(*v);
         }
         if t >= self.next_tick {
             let ticks = ((1000.0 * t / self.t_end) as u64).max(self.ticks);
@@ -115,18 +119,42 @@ impl<M: System<N> + ?Sized, const N: usize> Sink<N> for Collect<'_, M> {
 }
 
 /// The scenario's initial state (`rest` or `equilibrium`, plus its offsets).
+/// For a model padded with idle dofs ([`with_sim_system!`](crate::with_sim_system)),
+/// the real state placed in the padded one, the idle states zero.
 pub fn initial_of<M: System<N> + ?Sized, const N: usize>(
     model: &M,
     sc: &Scenario,
 ) -> Result<[f64; N], StudyError> {
-    let mut offsets = [0.0; N];
-    offsets.copy_from_slice(&sc.offsets);
-    initial_state(model, sc.initial, &offsets).map_err(|e| {
+    let real = sc.offsets.len();
+    let offsets: [f64; N] = if real == N {
+        let mut o = [0.0; N];
+        o.copy_from_slice(&sc.offsets);
+        o
+    } else {
+        padding::embed(&sc.offsets)
+    };
+    let z = initial_state(model, sc.initial, &offsets).map_err(|e| {
         StudyError::Input(InputError(format!(
             "initial = {}: {e}",
             sc.initial.as_str()
         )))
-    })
+    })?;
+    if real == N {
+        return Ok(z);
+    }
+    // The idle dofs start exactly at rest (so they stay there).
+    let mut out = [0.0; N];
+    for k in padding::real_states::<N>(real / 2) {
+        out[k] = z[k];
+    }
+    Ok(out)
+}
+
+/// The solver options of a run of `sc` on `N` states: the scenario's, with
+/// a padded model's per-state tolerances moved to its padded state indices
+/// (`squeal_core::model::lumped::padding`).
+pub fn sim_options<const N: usize>(sc: &Scenario) -> squeal_core::SolverOptions {
+    padding::padded_solver::<N>(&sc.solver, sc.offsets.len())
 }
 
 fn run_model<M: System<N> + ?Sized, const N: usize>(
@@ -138,8 +166,11 @@ fn run_model<M: System<N> + ?Sized, const N: usize>(
 ) -> Result<Run, StudyError> {
     cancel.check()?;
     let z0 = initial_of(model, sc)?;
+    // A padded model's idle dofs are not written: the run reads as the real model's.
+    let states: Vec<usize> = padding::real_states::<N>(sc.offsets.len() / 2).collect();
+    let names = model.names();
     let mut columns = vec!["t".to_string()];
-    columns.extend(model.names());
+    columns.extend(states.iter().map(|&i| names[i].clone()));
     columns.extend(any.derived_columns());
     let expected = (sc.duration * sc.sample_rate) as usize + 2;
     let mut sink = Collect {
@@ -148,6 +179,7 @@ fn run_model<M: System<N> + ?Sized, const N: usize>(
         data: (0..columns.len())
             .map(|_| Vec::with_capacity(expected))
             .collect(),
+        states,
         derived: Vec::with_capacity(8),
         obs: Vec::with_capacity(model.contacts()),
         events: Vec::new(),
@@ -165,7 +197,7 @@ fn run_model<M: System<N> + ?Sized, const N: usize>(
         z0,
         sc.duration,
         sc.sample_rate,
-        sc.solver,
+        sim_options::<N>(sc),
         &mut sink,
     )
     .map_err(|e| StudyError::Numerical(explain(e, sc.duration)))?;
@@ -203,6 +235,6 @@ pub fn explain(e: squeal_core::IntegrateError, duration: f64) -> String {
 /// reporting thousandths of its duration to `progress`, stopping with
 /// [`StudyError::Interrupted`] soon after `cancel` is set.
 pub fn run(sc: &Scenario, progress: &dyn Progress, cancel: &Cancel) -> Result<Run, StudyError> {
-    crate::with_system!(&sc.model, m => run_model(m, &sc.model, sc, progress, cancel),
+    crate::with_sim_system!(&sc.model, m => run_model(m, &sc.model, sc, progress, cancel),
         else => Err(StudyError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))))
 }

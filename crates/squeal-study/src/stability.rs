@@ -62,10 +62,10 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
 
 /// Whether [`levers`] are searched for this model: they need hundreds of
 /// analyses, so only models of the fixed-size path (every built-in, lumped
-/// models up to `MAX_SIM_DOFS` dofs) get them.
+/// models up to `MAX_EXACT_DOFS` dofs) get them.
 pub fn searches_levers(model: &AnyModel) -> bool {
     !matches!(model, AnyModel::Lumped(l)
-        if l.dof_count() > squeal_core::model::lumped::MAX_SIM_DOFS)
+        if l.dof_count() > squeal_core::model::lumped::MAX_EXACT_DOFS)
 }
 
 /// The levers of `model` when [`searches_levers`] says so, none otherwise.

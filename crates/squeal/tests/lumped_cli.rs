@@ -349,7 +349,133 @@ mu_k = 0.3
     let out = squeal(d.path(), &["simulate", "big.toml", "--out", "x"]);
     assert_eq!(out.status.code(), Some(2));
     let e = String::from_utf8_lossy(&out.stderr);
-    assert!(e.contains("300 dofs") && e.contains("up to 16"), "{e}");
+    assert!(e.contains("300 dofs") && e.contains("up to 64"), "{e}");
+    assert!(!d.path().join("x").exists());
+}
+
+/// A 20-dof lumped file (the disc–pad plus a separate chain of 16 masses,
+/// ringing from a displacement): `simulate` runs it (padded to 24 dofs
+/// inside, see `squeal_core::model::lumped::padding`) and writes exactly the
+/// file's dofs; its disc–pad moves as the 4-dof file's does (RMS to 1e-6:
+/// the steps differ because the error norm also weighs the chain); `map
+/// --transient` runs it; `cycle` names its own limit.
+#[test]
+fn a_20_dof_file_simulates_maps_and_names_the_cycle_limit() {
+    let d = tempfile::tempdir().unwrap();
+    let base = std::fs::read_to_string(scenarios().join("disc-pad.toml")).unwrap();
+    let chain: Vec<String> = (1..=16).map(|i| format!("c{i}")).collect();
+    let mut text = base.replace(
+        r#"dofs = ["x_d", "x_p", "y_d", "y_p"]"#,
+        &format!(
+            "dofs = [\"x_d\", \"x_p\", \"y_d\", \"y_p\", {}]",
+            chain
+                .iter()
+                .map(|c| format!("\"{c}\""))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    );
+    text = text.replacen(
+        "y_p = 0.1\n",
+        &format!(
+            "y_p = 0.1\n{}",
+            chain
+                .iter()
+                .map(|c| format!("{c} = 0.5\n"))
+                .collect::<String>()
+        ),
+        1,
+    );
+    for (i, c) in chain.iter().enumerate() {
+        let on = if i == 0 {
+            format!("{{ {c} = 1.0 }}")
+        } else {
+            format!("{{ {c} = 1.0, {} = -1.0 }}", chain[i - 1])
+        };
+        text.push_str(&format!(
+            "\n[[spring]]\nname = \"chain{}\"\non = {on}\nk = 1.0e6\nc = 0.5\n",
+            i + 1
+        ));
+    }
+    text.push_str("\n[offsets]\nc10 = 1e-3\n"); // c1 starts displaced (offset keys are <state>0)
+    std::fs::write(d.path().join("big20.toml"), &text).unwrap();
+    let args = ["--duration", "0.1", "--no-plots", "--format", "csv"];
+    let mut a = vec!["simulate", "big20.toml", "--out", "b20"];
+    a.extend(args);
+    ok(&squeal(d.path(), &a));
+    let small = scenarios().join("disc-pad.toml");
+    let mut a = vec!["simulate", small.to_str().unwrap(), "--out", "b4"];
+    a.extend(args);
+    ok(&squeal(d.path(), &a));
+    let read = |dir: &str| -> (Vec<String>, Vec<Vec<f64>>) {
+        let text = std::fs::read_to_string(d.path().join(dir).join("series.csv")).unwrap();
+        let mut lines = text.lines();
+        let head: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+        let rows = lines
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect();
+        (head, rows)
+    };
+    let (h20, r20) = read("b20");
+    let (h4, r4) = read("b4");
+    let mut want = vec!["t".to_string()];
+    for q in ["x_d", "x_p", "y_d", "y_p"]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(chain.clone())
+    {
+        want.push(q);
+    }
+    for q in ["x_d", "x_p", "y_d", "y_p"]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(chain.clone())
+    {
+        want.push(format!("v{q}"));
+    }
+    for c in ["F_n", "F_t", "v_rel", "mode"] {
+        want.push(format!("pad.{c}"));
+    }
+    assert_eq!(h20, want, "series.csv columns");
+    assert_eq!(r20.len(), r4.len());
+    let col = |h: &[String], name: &str| h.iter().position(|c| c == name).unwrap();
+    for name in ["vx_d", "vx_p", "vy_d", "vy_p"] {
+        let rms = |h: &[String], r: &[Vec<f64>]| {
+            let c = col(h, name);
+            (r.iter().map(|row| row[c] * row[c]).sum::<f64>() / r.len() as f64).sqrt()
+        };
+        let (x, y) = (rms(&h4, &r4), rms(&h20, &r20));
+        assert!((x - y).abs() <= 1e-6 * x, "{name}: RMS {x:e} vs {y:e}");
+    }
+    let c16 = col(&h20, "c16");
+    assert!(
+        r20.iter().any(|row| row[c16].abs() > 1e-6),
+        "the chain never rang"
+    );
+    let out = squeal(
+        d.path(),
+        &[
+            "map",
+            "big20.toml",
+            "--x",
+            "pad.V=0.5:2:2",
+            "--y",
+            "brake.value=-800:-200:2",
+            "--transient",
+            "--duration",
+            "0.02",
+            "--out",
+            "m20",
+        ],
+    );
+    ok(&out);
+    let map = std::fs::read_to_string(d.path().join("m20/map.csv")).unwrap();
+    assert_eq!(map.lines().count(), 5, "{map}");
+    assert!(!map.contains("failed"), "{map}");
+    let out = squeal(d.path(), &["cycle", "big20.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("20 dofs") && e.contains("up to 16"), "{e}");
 }
 
 #[test]

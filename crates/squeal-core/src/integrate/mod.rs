@@ -216,6 +216,8 @@ pub struct Solver<'m, M: System<N> + ?Sized, const N: usize> {
     model: &'m M,
     opts: SolverOptions,
     atol: [f64; N],
+    /// The state count the error norm averages over ([`System::norm_states`]).
+    norm_n: f64,
     t: f64,
     t_end: f64,
     z: [f64; N],
@@ -305,6 +307,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             model,
             opts,
             atol,
+            norm_n: model.norm_states() as f64,
             t: t0,
             t_end,
             z: z0,
@@ -488,7 +491,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             d0 += (z[i] / sk).powi(2);
             d1 += (f0[i] / sk).powi(2);
         }
-        let (d0, d1) = ((d0 / N as f64).sqrt(), (d1 / N as f64).sqrt());
+        let (d0, d1) = ((d0 / self.norm_n).sqrt(), (d1 / self.norm_n).sqrt());
         let h0 = if d0 < 1e-10 || d1 < 1e-10 {
             1e-6
         } else {
@@ -506,7 +509,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             let sk = self.atol[i] + self.opts.rtol * z[i].abs();
             d2 += ((f1[i] - f0[i]) / sk).powi(2);
         }
-        let d2 = (d2 / N as f64).sqrt() / h0;
+        let d2 = (d2 / self.norm_n).sqrt() / h0;
         let h1 = if d1.max(d2) <= 1e-15 {
             (h0 * 1e-3).max(1e-6)
         } else {
@@ -572,7 +575,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
         if err5 == 0.0 && err3 == 0.0 {
             0.0
         } else {
-            h.abs() * err5 / ((err5 + 0.01 * err3) * N as f64).sqrt()
+            h.abs() * err5 / ((err5 + 0.01 * err3) * self.norm_n).sqrt()
         }
     }
 

@@ -1943,6 +1943,10 @@ impl<const N: usize> System<N> for Lumped {
         Ok(out)
     }
 
+    fn norm_states(&self) -> usize {
+        self.real_state_count()
+    }
+
     fn state_jacobian(&self, z: &[f64; N]) -> [[f64; N]; N] {
         let a = self.jacobian_dyn(z);
         let mut out = [[0.0; N]; N];
@@ -1995,9 +1999,13 @@ impl Lumped {
 }
 
 /// Most dofs a lumped model may have to be simulated: the integrator works on
-/// fixed-size state arrays, so each size is compiled in (`2·MAX_SIM_DOFS`
-/// states at most). Stability analysis works for any size.
-pub const MAX_SIM_DOFS: usize = 16;
+/// fixed-size state arrays, so each size is compiled in — every size up to
+/// [`MAX_EXACT_DOFS`], then the padded sizes of [`PADDED_DOFS`] (see
+/// [`padding`]). Stability analysis works for any size.
+pub const MAX_SIM_DOFS: usize = 64;
+
+pub mod padding;
+pub use padding::{embed, padded_dofs, padded_solver, real_states, MAX_EXACT_DOFS, PADDED_DOFS};
 
 /// A lumped model seen at one state count `N = 2·dofs`, so that generic code
 /// (`simulate`, `analyse`) infers `N` from the type. Delegates everything.
@@ -2067,11 +2075,14 @@ impl<const N: usize> System<N> for Fixed<'_, N> {
     fn state_jacobian(&self, z: &[f64; N]) -> [[f64; N]; N] {
         <Lumped as System<N>>::state_jacobian(self.0, z)
     }
+    fn norm_states(&self) -> usize {
+        self.0.real_state_count()
+    }
 }
 
 /// Run `$body` with `$m` bound to `&Fixed<N>` for the lumped model `$l`
-/// (`N = 2·dofs`, dofs ≤ [`MAX_SIM_DOFS`]), or evaluate `$fallback` for a
-/// larger model.
+/// (`N = 2·dofs`, dofs ≤ [`MAX_EXACT_DOFS`]), or evaluate `$fallback` for a
+/// larger model (see [`with_padded_size!`](crate::with_padded_size) for simulation).
 #[macro_export]
 macro_rules! with_lumped_size {
     ($l:expr, $m:ident => $body:expr, else => $fallback:expr) => {{

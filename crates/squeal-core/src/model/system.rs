@@ -140,6 +140,13 @@ pub trait System<const N: usize>: Sync {
     fn steady_sliding(&self) -> Result<[f64; N], ModelError>;
     /// Analytic Jacobian `∂f/∂z` of the sliding equations at `z`.
     fn state_jacobian(&self, z: &[f64; N]) -> [[f64; N]; N];
+    /// How many states the integrator's error norm averages over,
+    /// `‖e‖ = √(Σ (e_i/sc_i)² / n)`: all `N`, except for a model padded with
+    /// idle states that never move ([`crate::model::lumped::padding`]),
+    /// whose norm is then the real states' — so it takes the same steps.
+    fn norm_states(&self) -> usize {
+        N
+    }
 }
 
 impl<M: Model<N>, const N: usize> System<N> for M {

@@ -4,7 +4,7 @@
 //! `2n × 2n` state matrix) up to [`ModalOptions::dense_max_dofs`] dofs, by
 //! projection onto the lowest undamped modes above ([`super::projected`]).
 //! Models small enough for the fixed-size path
-//! ([`crate::model::lumped::MAX_SIM_DOFS`] dofs) go through
+//! ([`crate::model::lumped::MAX_EXACT_DOFS`] dofs) go through
 //! [`super::analyse`] instead (the same eigenvalues).
 //!
 //! [`ModalOptions::dense_max_dofs`]: super::projected::ModalOptions::dense_max_dofs

@@ -151,7 +151,7 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     if large {
         crate::outln!(
             "(levers are searched only for models of up to {} dofs)",
-            squeal_core::model::lumped::MAX_SIM_DOFS
+            squeal_core::model::lumped::MAX_EXACT_DOFS
         );
     } else if levers.is_empty() {
         crate::outln!("no single parameter change within ×1000 either way changes the verdict");

@@ -1,0 +1,173 @@
+//! Simulating lumped models larger than the sizes compiled exactly.
+//!
+//! The integrator works on fixed-size state arrays (`[f64; N]`), compiled
+//! once per size. Models of up to [`MAX_EXACT_DOFS`] dofs get their own size;
+//! a larger one (up to [`MAX_SIM_DOFS`]) runs in the next of a few padded
+//! sizes ([`PADDED_DOFS`]): the model gains *idle* dofs — unit mass on a unit
+//! spring to ground, coupled to nothing, starting at rest — that stay
+//! exactly zero (their force `−1·0` is zero in floating point), so the real
+//! dofs move exactly as without them.
+//!
+//! The error norm would see the padding: DOP853 measures a step's error as
+//! an RMS over the states, `‖e‖ = √(Σ (e_i/sc_i)² / n)` with
+//! `sc_i = atol_i + rtol·|z_i|`. The idle states add exactly zero to the
+//! sum, and the padded model reports its real state count as `n`
+//! ([`System::norm_states`](crate::model::System::norm_states)), so a padded
+//! run takes the very steps of the unpadded one, bit for bit.
+//!
+//! Only simulation runs padded: an eigen-analysis of the padded model would
+//! add the idle dofs' modes (±i rad/s), so stability, cycles and their
+//! Floquet multipliers use the size-independent paths or the exact sizes.
+
+use super::{Combination, Lumped, Sparse, Spring};
+use crate::integrate::{SolverOptions, MAX_STATES};
+
+/// Largest model (dofs) compiled at its exact state count.
+pub const MAX_EXACT_DOFS: usize = 16;
+
+/// The padded sizes (dofs) a larger model runs in, smallest first.
+pub const PADDED_DOFS: [usize; 4] = [24, 32, 48, 64];
+
+/// Prefix of the idle dofs' names (`pad.1`, …): a `.` is not allowed in a
+/// user's dof name, so they never collide.
+pub const IDLE_PREFIX: &str = "pad.";
+
+/// The padded size (dofs) a model of `dofs` dofs is simulated in: `None` if it
+/// has an exact size (≤ [`MAX_EXACT_DOFS`]) or is too large (> [`MAX_SIM_DOFS`](super::MAX_SIM_DOFS)).
+pub fn padded_dofs(dofs: usize) -> Option<usize> {
+    if dofs <= MAX_EXACT_DOFS {
+        return None;
+    }
+    PADDED_DOFS.iter().copied().find(|&p| p >= dofs)
+}
+
+impl Sparse {
+    /// The same matrix as a `size × size` one (empty rows added).
+    fn grown(&self, size: usize) -> Sparse {
+        let mut s = self.clone();
+        let end = *s.row_ptr.last().unwrap_or(&0);
+        s.row_ptr.resize(size + 1, end);
+        s.n = size;
+        s
+    }
+}
+
+impl Lumped {
+    /// This model with idle dofs appended up to `dofs` (see the module docs):
+    /// state order `q_real, q_idle, q̇_real, q̇_idle`. The real dofs keep their
+    /// indices; elements, contacts and parameters are unchanged.
+    pub fn padded_to(&self, dofs: usize) -> Lumped {
+        let n = self.dofs.len();
+        let mut p = self.clone();
+        for k in n..dofs {
+            let name = format!("{IDLE_PREFIX}{}", k - n + 1);
+            p.springs.push(Spring {
+                name: name.clone(),
+                on: Combination {
+                    idx: vec![k],
+                    coef: vec![1.0],
+                },
+                k: 1.0,
+                c: 0.0,
+            });
+            p.dofs.push(name);
+            p.masses.push(1.0);
+        }
+        for m in [&mut p.m_matrix, &mut p.k_matrix, &mut p.c_matrix]
+            .into_iter()
+            .flatten()
+        {
+            *m = m.grown(dofs);
+        }
+        p.states = p
+            .dofs
+            .iter()
+            .cloned()
+            .chain(p.dofs.iter().map(|d| format!("v{d}")))
+            .collect();
+        // The real model passed these checks; the idle dofs add a diagonal unit mass.
+        p.refresh()
+            .expect("padding adds only unit masses and springs to a valid model");
+        p
+    }
+}
+
+/// A real state vector (`q, q̇` of `n` dofs) placed in a padded one of `N`
+/// states (`q_real, 0, q̇_real, 0`).
+pub fn embed<const N: usize>(real: &[f64]) -> [f64; N] {
+    let n = real.len() / 2;
+    let mut z = [0.0; N];
+    z[..n].copy_from_slice(&real[..n]);
+    z[N / 2..N / 2 + n].copy_from_slice(&real[n..]);
+    z
+}
+
+/// Indices, in a padded state of `N` states, of the `2·n` real states (in order).
+pub fn real_states<const N: usize>(n: usize) -> impl Iterator<Item = usize> {
+    (0..n).chain(N / 2..N / 2 + n)
+}
+
+/// The solver options for a padded run of `N` states whose real state count
+/// is `real`: the per-state tolerances (`atol_state`, indexed by real state)
+/// moved to the padded indices. Unchanged when `real == N`.
+pub fn padded_solver<const N: usize>(opts: &SolverOptions, real: usize) -> SolverOptions {
+    if real >= N {
+        return *opts;
+    }
+    let n = real / 2;
+    let mut o = *opts;
+    o.atol_state = [None; MAX_STATES];
+    for (i, a) in opts.atol_state.iter().enumerate() {
+        let padded = if i < n { i } else { N / 2 + i - n };
+        if let (Some(a), Some(slot)) = (a, o.atol_state.get_mut(padded)) {
+            *slot = Some(*a);
+        }
+    }
+    o
+}
+
+impl Lumped {
+    /// The real (not idle) state count: `2·dofs` for a model that is not padded.
+    pub(super) fn real_state_count(&self) -> usize {
+        2 * self
+            .dofs
+            .iter()
+            .filter(|d| !d.starts_with(IDLE_PREFIX))
+            .count()
+    }
+}
+
+/// Run `$body` with `$m` bound to `&Fixed<N>` of the lumped model `$l`
+/// padded to the next of [`PADDED_DOFS`] (models of more than
+/// [`MAX_EXACT_DOFS`] and at most [`MAX_SIM_DOFS`](super::MAX_SIM_DOFS) dofs;
+/// simulation only, see the module docs), or evaluate `$fallback`.
+#[macro_export]
+macro_rules! with_padded_size {
+    ($l:expr, $m:ident => $body:expr, else => $fallback:expr) => {{
+        use $crate::model::lumped::{padded_dofs, Fixed};
+        let l: &$crate::Lumped = $l;
+        match padded_dofs(l.dof_count()) {
+            Some(24) => {
+                let p = l.padded_to(24);
+                let $m = &Fixed::<48>(&p);
+                $body
+            }
+            Some(32) => {
+                let p = l.padded_to(32);
+                let $m = &Fixed::<64>(&p);
+                $body
+            }
+            Some(48) => {
+                let p = l.padded_to(48);
+                let $m = &Fixed::<96>(&p);
+                $body
+            }
+            Some(64) => {
+                let p = l.padded_to(64);
+                let $m = &Fixed::<128>(&p);
+                $body
+            }
+            _ => $fallback,
+        }
+    }};
+}

@@ -1,0 +1,161 @@
+//! Lumped models simulated in a padded state size
+//! (`squeal_core::model::lumped::padding`): idle dofs stay exactly at rest,
+//! and with the scaled tolerances the real dofs move as in the exact size.
+
+use squeal_core::model::lumped::{
+    disc_pad_spec, padded_dofs, padded_solver, LumpedSpec, SpringSpec, MAX_EXACT_DOFS, MAX_SIM_DOFS,
+};
+use squeal_core::sink::{EventLog, Recorder};
+// `padded_solver` only moves per-state tolerances; these runs have none.
+use squeal_core::{simulate, DiscPad, Lumped, Parameters, SolverOptions};
+
+fn disc_pad_opts() -> SolverOptions {
+    SolverOptions {
+        atol_pos: Some(1e-16),
+        atol_vel: Some(1e-11),
+        ..Default::default()
+    }
+}
+
+fn disc_pad_at_n_2000() -> Lumped {
+    let mut dp = DiscPad::default();
+    dp.set("N", 2000.0).unwrap();
+    Lumped::build(&disc_pad_spec(&dp)).unwrap()
+}
+
+#[test]
+fn padded_sizes_cover_every_model_up_to_the_limit() {
+    for dofs in 1..=MAX_EXACT_DOFS {
+        assert_eq!(padded_dofs(dofs), None, "{dofs} dofs have an exact size");
+    }
+    for dofs in MAX_EXACT_DOFS + 1..=MAX_SIM_DOFS {
+        let p = padded_dofs(dofs).unwrap_or_else(|| panic!("{dofs} dofs: no size"));
+        assert!(p >= dofs && p <= MAX_SIM_DOFS, "{dofs} → {p}");
+    }
+    assert_eq!(padded_dofs(MAX_SIM_DOFS + 1), None);
+    assert_eq!(padded_dofs(17), Some(24));
+    assert_eq!(padded_dofs(64), Some(64));
+}
+
+/// The disc–pad at N = 2000 (stick-slip from rest, over 12 000 events in
+/// 0.5 s) padded from 4 to 6 dofs: the idle states are exactly zero at every
+/// sample and event, and the run is the exact-size run bit for bit — the
+/// same steps, every event's kind, contact, time and state, every sample.
+#[test]
+fn a_padded_disc_pad_is_the_exact_size_run_bit_for_bit() {
+    let lp = disc_pad_at_n_2000();
+    let padded = lp.padded_to(6);
+    assert_eq!(padded.dof_count(), 6);
+    assert_eq!(&padded.dofs()[4..], ["pad.1", "pad.2"]);
+    let opts = disc_pad_opts();
+    let (mut a, mut b) = (Recorder::<8>::new(), Recorder::<12>::new());
+    let ia = simulate(&lp, 0.0, [0.0; 8], 0.5, 1000.0, opts, &mut a).unwrap();
+    let ib = simulate(
+        &padded,
+        0.0,
+        [0.0; 12],
+        0.5,
+        1000.0,
+        padded_solver::<12>(&opts, 8),
+        &mut b,
+    )
+    .unwrap();
+    let idle = [4, 5, 10, 11];
+    let real = |z: &[f64; 12]| -> [f64; 8] {
+        let mut r = [0.0; 8];
+        r[..4].copy_from_slice(&z[..4]);
+        r[4..].copy_from_slice(&z[6..10]);
+        r
+    };
+    for z in b.z.iter().chain(b.events.iter().map(|e| &e.z)) {
+        assert!(idle.iter().all(|&i| z[i] == 0.0), "idle state moved: {z:?}");
+    }
+    assert_eq!(
+        (ia.stats.accepted, ia.stats.rejected, ia.stats.rhs_evals),
+        (ib.stats.accepted, ib.stats.rejected, ib.stats.rhs_evals)
+    );
+    assert!(a.events.len() > 10_000, "only {} events", a.events.len());
+    assert_eq!(a.events.len(), b.events.len());
+    for (k, (x, y)) in a.events.iter().zip(&b.events).enumerate() {
+        assert_eq!(
+            (x.kind, x.contact, x.t),
+            (y.kind, y.contact, y.t),
+            "event {k}"
+        );
+        assert_eq!(x.z, real(&y.z), "event {k}");
+    }
+    assert_eq!(a.t, b.t);
+    for (x, y) in a.z.iter().zip(&b.z) {
+        assert_eq!(*x, real(y));
+    }
+}
+
+/// A 20-dof model (the disc–pad plus a separate chain of 16 masses, ringing
+/// from an initial displacement) runs padded to 24 dofs: the disc–pad's
+/// events equal those of the 4-dof model to 1e-9 s (the error norm now also
+/// weighs the chain's 32 states, so the steps differ; both runs are
+/// accurate to rtol = 1e-8).
+#[test]
+fn a_20_dof_model_runs_padded_and_its_disc_pad_moves_as_alone() {
+    let mut dp = DiscPad::default();
+    dp.set("N", 2000.0).unwrap();
+    let mut spec: LumpedSpec = disc_pad_spec(&dp);
+    for i in 1..=16 {
+        let name = format!("c{i}");
+        spec.dofs.push(name.clone());
+        spec.masses.push((name.clone(), 0.5));
+        let mut on = vec![(name, 1.0)];
+        if i > 1 {
+            on.push((format!("c{}", i - 1), -1.0));
+        }
+        spec.springs.push(SpringSpec {
+            name: format!("chain{i}"),
+            on,
+            k: 1.0e6,
+            c: 0.5,
+        });
+    }
+    let big = Lumped::build(&spec).unwrap();
+    assert_eq!(big.dof_count(), 20);
+    let padded = big.padded_to(padded_dofs(20).unwrap());
+    let mut z0 = [0.0; 48];
+    z0[4] = 1e-3; // c1 displaced
+    let opts = disc_pad_opts();
+    let (mut a, mut b) = (EventLog::<8>::default(), Recorder::<48>::new());
+    simulate(
+        &disc_pad_at_n_2000(),
+        0.0,
+        [0.0; 8],
+        0.3,
+        1000.0,
+        opts,
+        &mut a,
+    )
+    .unwrap();
+    simulate(
+        &padded,
+        0.0,
+        z0,
+        0.3,
+        1000.0,
+        padded_solver::<48>(&opts, 40),
+        &mut b,
+    )
+    .unwrap();
+    // The chain rings (it is simulated, not frozen); the idle dofs do not.
+    assert!(
+        b.z.iter().any(|z| z[19].abs() > 1e-6),
+        "the chain's end never moved"
+    );
+    for z in &b.z {
+        assert!((20..24).chain(44..48).all(|i| z[i] == 0.0));
+    }
+    assert!(a.events.len() >= 16, "only {} events", a.events.len());
+    let mut worst = 0.0f64;
+    for (k, (x, y)) in a.events.iter().zip(&b.events).take(16).enumerate() {
+        assert_eq!(x.kind, y.kind, "event {k}");
+        worst = worst.max((x.t - y.t).abs());
+    }
+    eprintln!("first 16 events: largest time difference {worst:e} s");
+    assert!(worst <= 1e-9, "event times differ by up to {worst:e} s");
+}
