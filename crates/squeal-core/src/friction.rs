@@ -283,7 +283,7 @@ impl FrictionLaw {
     /// formula; the Stribeck law uses |v|), which the integrator evaluates
     /// only inside a step that overshoots a slip reversal before the event is
     /// located: a kink there would make the error estimate reject the step.
-    #[inline]
+    #[inline(always)]
     pub fn mu(&self, v: f64) -> f64 {
         match *self {
             FrictionLaw::Thesis { f0, f1, uc } => f0 * (1.0 - f1 * v * (1.0 - v / (2.0 * uc))),

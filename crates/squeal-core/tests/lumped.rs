@@ -822,18 +822,26 @@ fn large_decoupled_model_has_the_closed_form_eigenvalues() {
 }
 
 /// The simulation's right-hand side of a small model runs on folded
-/// operators (springs, `K`, `C` in one sparse list, constant forces in one
-/// vector, contacts as index pairs); the stability and equilibrium code on
-/// the element loops. Both are the same force: equal to 1e-12 of the
-/// largest term, in every mode combination, with a follower force, a
-/// ramped force, a bilateral contact, a prescribed load, a mass matrix
-/// with off-diagonal terms, and after parameters changed by `set`.
+/// operators (springs, `K`, `C` as two diagonals and the off-diagonal
+/// entries, constant forces in one vector, contacts as dense rows; one
+/// contact without the contact loop; a "plain" model — no ramp, no
+/// off-diagonal entry, diagonal masses — in one pass); the stability and
+/// equilibrium code on the element loops. Both are the same force: equal
+/// to 1e-12 of the largest term, in every mode combination, with a
+/// follower force, a ramped force, a bilateral contact, a prescribed load,
+/// a mass matrix with off-diagonal terms, and after parameters changed by
+/// `set`.
 #[test]
 fn folded_field_equals_the_element_loops() {
     use squeal_core::model::lumped::{disc_pad_spec, two_pad_spec, Fixed, Triplets};
     let mut follower = disc_pad_spec(&DiscPad::default());
     follower.contacts[0].alpha = 0.4;
     follower.forces[0].ramp = 0.01;
+    // Plain (no ramp, diagonal masses, springs on single dofs), one contact.
+    let mut plain = disc_pad_spec(&DiscPad::default());
+    plain.contacts[0].alpha = 0.4;
+    let mut plain_bilateral = plain.clone();
+    plain_bilateral.contacts[0].bilateral = true;
     let mut bilateral = two_pad_spec();
     bilateral.contacts[1].bilateral = true;
     let mut belt = LumpedSpec {
@@ -913,6 +921,14 @@ fn folded_field_equals_the_element_loops() {
     };
     for (label, spec, pos, vel) in [
         ("follower", follower, 1e-6, 0.5),
+        ("plain", plain, 1e-6, 0.5),
+        (
+            "plain without follower",
+            disc_pad_spec(&DiscPad::default()),
+            1e-6,
+            0.5,
+        ),
+        ("plain bilateral", plain_bilateral, 1e-6, 0.5),
         ("two-pad bilateral", bilateral, 1e-6, 0.5),
         ("belt with M, K", belt, 1e-2, 0.5),
     ] {

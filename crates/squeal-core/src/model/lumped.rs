@@ -269,8 +269,9 @@ pub struct Lumped {
     pub springs: Vec<Spring>,
     /// Forces (as [`Lumped::springs`]: change them through [`Lumped::set`]).
     pub forces: Vec<Force>,
-    /// Contacts (their combinations are derived into the right-hand side's
-    /// operators; laws, `V`, `alpha`, `k`, `c` are read directly).
+    /// Contacts (their combinations, `k`, `c` and the bilateral flag are
+    /// folded into the right-hand side's operators: change those through
+    /// [`Lumped::set`]; laws, `V` and `alpha` are read directly).
     pub contacts: Vec<Contact>,
     /// How the complex eigenvalue analysis is solved (dense or projected;
     /// keys `modal.dense_max_dofs`, `modal.modes`, `modal.cutoff_hz`).
@@ -290,37 +291,85 @@ pub struct Lumped {
 }
 
 /// Up to this many dofs the simulated right-hand side runs on operators
-/// folded once per parameter change (every spring, `K` and `C` in one list
-/// of non-zero entries, the constant forces in one vector) instead of
-/// looping over the elements.
+/// folded once per parameter change (every spring, `K` and `C` in one
+/// operator, the constant forces in one vector, each contact's combinations
+/// as dense rows) instead of looping over the elements.
 pub const DENSE_FIELD_DOFS: usize = 16;
 
-/// The right-hand side of a small model as folded sparse operators: every
-/// spring, `K` and `C` in one list of non-zero entries of the `n × 2n`
-/// matrix `∂force/∂z`, the constant forces in one vector, each contact's
-/// combinations as `(index, coefficient)` pairs on the state.
-#[derive(Debug, Clone, PartialEq, Default)]
+/// A dense row on the dofs (`n ≤ DENSE_FIELD_DOFS` entries used).
+type Row = [f64; DENSE_FIELD_DOFS];
+
+/// The right-hand side of a small model on folded operators. The force of
+/// every spring, `K` and `C`, `∂force/∂z`, is split into its diagonals on
+/// `q` and on `q̇` (dense rows: the loops over them have the model's size
+/// as a compile-time trip count in [`System::field`] and no bounds checks)
+/// and the remaining off-diagonal entries; each contact's combinations are
+/// dense rows, so its dot products and scatters are straight-line code.
+#[derive(Debug, Clone, PartialEq)]
 struct DenseField {
-    /// Number of dofs.
-    n: usize,
-    /// `(row, column on z, value)`: the force of springs, `K` and `C` is
-    /// `Σ value·z[column]` into `row` (duplicates summed at build).
-    kc: Vec<(usize, usize, f64)>,
     /// `Σ value·on` of the forces without a ramp.
-    f0: Vec<f64>,
-    /// Per contact: `F_n` on `z` (`(k n, c n)`), the normal on the dofs,
-    /// the sliding velocity's `t` on `z` (velocities), the slope on `z`.
-    contacts: Vec<[Vec<(usize, f64)>; 4]>,
+    f0: Row,
+    /// Diagonal of `∂force/∂q` (springs and `K`, negated).
+    kd: Row,
+    /// Diagonal of `∂force/∂q̇` (springs and `C`, negated).
+    cd: Row,
+    /// The other entries `(row, column on z, value)`, row-major, duplicates
+    /// summed: their force is `Σ value·z[column]` into `row`.
+    off: Vec<(usize, usize, f64)>,
+    /// `M⁻¹` when it is diagonal (else zero).
+    inv_mass: Row,
+    /// Plain: no ramped force, no off-diagonal entry, a diagonal `M⁻¹`: the
+    /// force is `f0 + kd·q + cd·q̇` and the contacts', then scaled by `inv_mass`.
+    plain: bool,
+    /// Per contact (in order), its combinations as dense rows.
+    contacts: Vec<FoldedContact>,
 }
 
-/// `Σ coef·z[index]`.
+/// One contact's combinations as dense rows (the contact's `V`, friction
+/// law and `alpha` are read from the [`Contact`] itself).
+#[derive(Debug, Clone, PartialEq)]
+struct FoldedContact {
+    /// `F_n = fn_q·q + fn_u·q̇` (`k n` and `c n`; zero for a prescribed load).
+    fn_q: Row,
+    /// See `fn_q`.
+    fn_u: Row,
+    /// The normal `n` on the dofs.
+    normal: Row,
+    /// The tangent `t` (the sliding velocity is `V + t·q̇`).
+    tangent: Row,
+    /// The follower force's slope `s` (on `q`).
+    slope: Row,
+    /// A bilateral layer: friction acts on `max(F_n, 0)`.
+    bilateral: bool,
+}
+
+/// `Σ a_i·b_i` summed in index order (the terms with a zero coefficient add
+/// an exact zero, so the sum equals the sum over the non-zero terms),
+/// starting from the first product rather than from `0 + a_0·b_0` (one
+/// addition less on the critical path; only the sign of an all-zero sum can
+/// differ).
 #[inline(always)]
-fn dot_pairs(pairs: &[(usize, f64)], z: &[f64]) -> f64 {
-    let mut s = 0.0;
-    for &(i, c) in pairs {
-        s += c * z[i];
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    match (a.split_first(), b.split_first()) {
+        (Some((x, a)), Some((y, b))) => dot_from(x * y, a, b),
+        _ => 0.0,
+    }
+}
+
+/// `s + Σ a_i·b_i`, added in index order.
+#[inline(always)]
+fn dot_from(mut s: f64, a: &[f64], b: &[f64]) -> f64 {
+    for (x, y) in a.iter().zip(b) {
+        s += x * y;
     }
     s
+}
+
+/// A combination as a dense row on `n ≤ DENSE_FIELD_DOFS` dofs, scaled by `a`.
+fn dense_row(c: &Combination, a: f64) -> Row {
+    let mut r = [0.0; DENSE_FIELD_DOFS];
+    c.add_scaled(&mut r, a);
+    r
 }
 
 /// Up to this many dofs, guard evaluations use a stack buffer (no allocation).
@@ -771,7 +820,7 @@ impl Lumped {
         Ok(())
     }
 
-    /// Rebuild the dense operators of the right-hand side ([`DenseField`])
+    /// Rebuild the folded operators of the right-hand side ([`DenseField`])
     /// from the elements (small models only).
     fn rebuild_dense(&mut self) {
         let n = self.dofs.len();
@@ -798,93 +847,242 @@ impl Lumped {
                 kc[r * 2 * n + n + c] -= v;
             }
         }
-        let mut f0 = vec![0.0; n];
+        let (mut kd, mut cd) = ([0.0; DENSE_FIELD_DOFS], [0.0; DENSE_FIELD_DOFS]);
+        let mut off = Vec::new();
+        for (k, &x) in kc.iter().enumerate() {
+            let (r, c) = (k / (2 * n), k % (2 * n));
+            if c == r {
+                kd[r] = x;
+            } else if c == n + r {
+                cd[r] = x;
+            } else if x != 0.0 {
+                off.push((r, c, x));
+            }
+        }
+        let mut f0 = [0.0; DENSE_FIELD_DOFS];
         for f in self.forces.iter().filter(|f| f.ramp <= 0.0) {
             f.on.add_scaled(&mut f0, f.value);
         }
-        let pairs = |v: &[f64]| -> Vec<(usize, f64)> {
-            v.iter()
-                .enumerate()
-                .filter(|(_, x)| **x != 0.0)
-                .map(|(i, x)| (i, *x))
-                .collect()
+        let mut inv_mass = [0.0; DENSE_FIELD_DOFS];
+        let diagonal = match &self.inv_mass {
+            InvMass::Diagonal(inv) => {
+                inv_mass[..n].copy_from_slice(inv);
+                true
+            }
+            InvMass::Dense(_) => false,
         };
+        let plain = diagonal && off.is_empty() && !self.has_ramp;
         let contacts = self
             .contacts
             .iter()
             .map(|c| {
-                let mut f_n = vec![0.0; 2 * n];
-                let mut nrm = vec![0.0; n];
-                if let Normal::Elastic {
-                    normal, k, c: cc, ..
-                } = &c.normal
-                {
-                    normal.add_scaled(&mut f_n[..n], *k);
-                    normal.add_scaled(&mut f_n[n..], *cc);
-                    normal.add_scaled(&mut nrm, 1.0);
+                let (fn_q, fn_u, normal) = match &c.normal {
+                    Normal::Elastic {
+                        normal, k, c: cc, ..
+                    } => (
+                        dense_row(normal, *k),
+                        dense_row(normal, *cc),
+                        dense_row(normal, 1.0),
+                    ),
+                    Normal::Prescribed(_) => {
+                        let zero = [0.0; DENSE_FIELD_DOFS];
+                        (zero, zero, zero)
+                    }
+                };
+                FoldedContact {
+                    fn_q,
+                    fn_u,
+                    normal,
+                    tangent: dense_row(&c.tangent, 1.0),
+                    slope: dense_row(&c.slope, 1.0),
+                    bilateral: matches!(
+                        c.normal,
+                        Normal::Elastic {
+                            bilateral: true,
+                            ..
+                        }
+                    ),
                 }
-                let mut tan = vec![0.0; 2 * n];
-                c.tangent.add_scaled(&mut tan[n..], 1.0);
-                let mut slope = vec![0.0; 2 * n];
-                c.slope.add_scaled(&mut slope[..n], 1.0);
-                [pairs(&f_n), pairs(&nrm), pairs(&tan), pairs(&slope)]
             })
             .collect();
         self.dense = Some(DenseField {
-            n,
-            kc: kc
-                .iter()
-                .enumerate()
-                .filter(|(_, x)| **x != 0.0)
-                .map(|(k, x)| (k / (2 * n), k % (2 * n), *x))
-                .collect(),
             f0,
+            kd,
+            cd,
+            off,
+            inv_mass,
+            plain,
             contacts,
         });
     }
 
-    /// The generalised force without stick multipliers on the folded
-    /// operators ([`DenseField`]) into `acc[..n]`: the same force as
-    /// [`Lumped::base_force`] (summed in another order).
+    /// `F_n` of a contact that touches, from its folded rows.
     #[inline(always)]
-    fn base_force_fixed(&self, d: &DenseField, t: f64, modes: &Modes, z: &[f64], acc: &mut [f64]) {
-        acc.copy_from_slice(&d.f0);
-        if self.has_ramp {
+    fn normal_folded(c: &Contact, fc: &FoldedContact, q: &[f64], u: &[f64]) -> f64 {
+        let n = q.len();
+        match c.normal {
+            Normal::Elastic { .. } => dot_from(dot(&fc.fn_q[..n], q), &fc.fn_u[..n], u),
+            Normal::Prescribed(f) => f,
+        }
+    }
+
+    /// The friction force `F_t = s·μ(s·v)·F_n` (`F_n⁺` for a bilateral
+    /// layer) of a contact in slip mode `mode`, from its folded rows.
+    #[inline(always)]
+    fn slip_folded(c: &Contact, fc: &FoldedContact, mode: Mode, f_n: f64, u: &[f64]) -> f64 {
+        let n = u.len();
+        let v = c.v + dot(&fc.tangent[..n], u);
+        let f_nf = if fc.bilateral { f_n.max(0.0) } else { f_n };
+        // s = ±1 applied as negations (the same bits, no multiplications on
+        // the critical path), one call of the law (so that it stays inline).
+        let pos = mode == Mode::SlipPos;
+        let mu = c.friction.mu(if pos { v } else { -v });
+        if pos {
+            mu * f_nf
+        } else {
+            -mu * f_nf
+        }
+    }
+
+    /// Add the force of contact `c` in `mode` to `acc` (its normal force,
+    /// and in slip its friction and follower force), from its folded rows
+    /// `fc`; `true` if it sticks (its friction force is a multiplier).
+    #[inline(always)]
+    fn contact_folded(
+        c: &Contact,
+        fc: &FoldedContact,
+        mode: Mode,
+        q: &[f64],
+        u: &[f64],
+        acc: &mut [f64],
+    ) -> bool {
+        let n = acc.len();
+        if mode == Mode::Free {
+            return false;
+        }
+        let f_n = Self::normal_folded(c, fc, q, u);
+        if mode == Mode::Stick {
+            // (A prescribed load's normal row is zero: `a − F_n·0 = a`.)
+            for (a, x) in acc.iter_mut().zip(&fc.normal[..n]) {
+                *a -= f_n * x;
+            }
+            return true;
+        }
+        let f_t = Self::slip_folded(c, fc, mode, f_n, u);
+        for ((a, x), y) in acc.iter_mut().zip(&fc.normal[..n]).zip(&fc.tangent[..n]) {
+            *a = *a - f_n * x - f_t * y;
+        }
+        if c.alpha != 0.0 {
+            let f_f = c.alpha * f_t * dot(&fc.slope[..n], q);
+            for (a, x) in acc.iter_mut().zip(&fc.normal[..n]) {
+                *a += f_f * x;
+            }
+        }
+        false
+    }
+
+    /// The right-hand side on the folded operators ([`DenseField`]) for
+    /// `N = 2n ≤ 2·DENSE_FIELD_DOFS` states: the same force as
+    /// [`Lumped::base_force`] (summed in another order) with the stick
+    /// multipliers, then `M⁻¹`. For models whose springs, `K` and `C` act on
+    /// single dofs (no off-diagonal entries) the sums are those of the
+    /// element-by-element fold this replaced, bit for bit.
+    #[inline(always)]
+    fn field_folded<const N: usize>(
+        &self,
+        d: &DenseField,
+        t: f64,
+        modes: &Modes,
+        z: &[f64; N],
+        dz: &mut [f64; N],
+    ) {
+        let n = N / 2;
+        let (q, u) = z.split_at(n);
+        // The force is summed in `dz[n..]` (every component is written), then scaled by M⁻¹ in place.
+        let (dq, acc) = dz.split_at_mut(n);
+        dq.copy_from_slice(u);
+        if d.plain {
+            for (i, a) in acc.iter_mut().enumerate() {
+                *a = d.f0[i] + d.kd[i] * q[i] + d.cd[i] * u[i];
+            }
+        } else {
+            acc.copy_from_slice(&d.f0[..n]);
             for f in self.forces.iter().filter(|f| f.ramp > 0.0) {
                 f.on.add_scaled(acc, f.value * f.factor(t));
             }
-        }
-        for &(r, c, v) in &d.kc {
-            acc[r] += v * z[c];
-        }
-        for ((i, c), [f_n_on, nrm, tan, slope]) in self.contacts.iter().enumerate().zip(&d.contacts)
-        {
-            let mode = modes.get(i);
-            if mode == Mode::Free {
-                continue;
+            for (i, a) in acc.iter_mut().enumerate() {
+                *a = *a + d.kd[i] * q[i] + d.cd[i] * u[i];
             }
-            let f_n = match &c.normal {
-                Normal::Elastic { .. } => {
-                    let f_n = dot_pairs(f_n_on, z);
-                    for &(j, x) in nrm {
-                        acc[j] -= f_n * x;
+            for &(r, c, v) in &d.off {
+                acc[r] += v * z[c];
+            }
+        }
+        // A plain model with one contact in slip: the contact's forces and
+        // M⁻¹ in one pass (the same operations, one store per dof).
+        if let (true, [c], [fc]) = (d.plain, &self.contacts[..], &d.contacts[..]) {
+            let mode = modes.first();
+            if mode == Mode::SlipPos || mode == Mode::SlipNeg {
+                let f_n = Self::normal_folded(c, fc, q, u);
+                let f_t = Self::slip_folded(c, fc, mode, f_n, u);
+                let (nrm, tan, inv) = (&fc.normal[..n], &fc.tangent[..n], &d.inv_mass[..n]);
+                if c.alpha != 0.0 {
+                    let f_f = c.alpha * f_t * dot(&fc.slope[..n], q);
+                    for i in 0..n {
+                        acc[i] = (acc[i] - f_n * nrm[i] - f_t * tan[i] + f_f * nrm[i]) * inv[i];
                     }
-                    f_n
-                }
-                Normal::Prescribed(f) => *f,
-            };
-            if mode != Mode::Stick {
-                let f_t = c.slip_force(mode, c.v + dot_pairs(tan, z), f_n);
-                let n = d.n;
-                for &(j, x) in tan {
-                    acc[j - n] -= f_t * x;
-                }
-                if c.alpha != 0.0 && matches!(c.normal, Normal::Elastic { .. }) {
-                    let f_f = c.alpha * f_t * dot_pairs(slope, z);
-                    for &(j, x) in nrm {
-                        acc[j] += f_f * x;
+                } else {
+                    for i in 0..n {
+                        acc[i] = (acc[i] - f_n * nrm[i] - f_t * tan[i]) * inv[i];
                     }
                 }
+                return;
+            }
+        }
+        // One contact (the commonest case) without the loop's machinery.
+        let sticking = match (&self.contacts[..], &d.contacts[..]) {
+            ([c], [fc]) => Self::contact_folded(c, fc, modes.first(), q, u, acc),
+            _ => {
+                let mut sticking = false;
+                for ((c, fc), &mode) in self.contacts.iter().zip(&d.contacts).zip(modes.as_slice())
+                {
+                    sticking |= Self::contact_folded(c, fc, mode, q, u, acc);
+                }
+                sticking
+            }
+        };
+        if sticking {
+            self.add_stick_forces(modes, q, acc);
+        }
+        if d.plain {
+            for (a, m) in acc.iter_mut().zip(&d.inv_mass[..n]) {
+                *a *= m;
+            }
+        } else {
+            let mut f = [0.0; N];
+            f[..n].copy_from_slice(acc);
+            self.apply_inv_mass(&f[..n], acc);
+        }
+    }
+
+    /// The right-hand side of any model: on the folded operators up to
+    /// [`DENSE_FIELD_DOFS`] dofs, else on the elements.
+    #[inline(never)]
+    fn field_general<const N: usize>(
+        &self,
+        t: f64,
+        modes: &Modes,
+        z: &[f64; N],
+        dz: &mut [f64; N],
+    ) {
+        match &self.dense {
+            Some(d) if N / 2 <= DENSE_FIELD_DOFS => self.field_folded(d, t, modes, z, dz),
+            _ => {
+                let n = N / 2;
+                let (q, u) = z.split_at(n);
+                let mut acc = [0.0; N];
+                self.force(t, modes, q, u, &mut acc[..n]);
+                dz[..n].copy_from_slice(u);
+                self.apply_inv_mass(&acc[..n], &mut dz[n..]);
             }
         }
     }
@@ -1667,24 +1865,23 @@ impl<const N: usize> System<N> for Lumped {
         &self.contacts[i].name
     }
 
-    #[inline]
+    /// The commonest small model (plain, one contact) inline in the
+    /// integrator's stages; every other model through `Lumped::field_general`
+    /// (one out-of-line copy, so that the stages stay compact).
+    #[inline(always)]
     fn field(&self, t: f64, modes: &Modes, z: &[f64; N], dz: &mut [f64; N]) {
-        let n = N / 2;
-        let (q, u) = z.split_at(n);
-        let mut acc = [0.0; N];
         match &self.dense {
-            Some(d) => {
-                self.base_force_fixed(d, t, modes, z, &mut acc[..n]);
-                if modes.as_slice().contains(&Mode::Stick) {
-                    self.add_stick_forces(modes, q, &mut acc[..n]);
-                }
+            // (The size test is a constant of each compiled size.)
+            Some(d)
+                if N / 2 <= DENSE_FIELD_DOFS
+                    && d.plain
+                    && d.contacts.len() == 1
+                    && self.contacts.len() == 1 =>
+            {
+                self.field_folded(d, t, modes, z, dz)
             }
-            _ => {
-                self.force(t, modes, q, u, &mut acc[..n]);
-            }
+            _ => self.field_general(t, modes, z, dz),
         }
-        dz[..n].copy_from_slice(u);
-        self.apply_inv_mass(&acc[..n], &mut dz[n..]);
     }
 
     fn mode_guards(&self, modes: &Modes, out: &mut Guards<N>) {
@@ -1928,7 +2125,11 @@ impl<const N: usize> System<N> for Lumped {
         self.observe_dyn(t, modes, z, i)
     }
 
+    #[inline]
     fn breakpoint_after(&self, t: f64) -> Option<f64> {
+        if !self.has_ramp {
+            return None;
+        }
         self.forces
             .iter()
             .filter(|f| f.ramp > 0.0 && t < f.ramp)
@@ -2066,6 +2267,7 @@ impl<const N: usize> System<N> for Fixed<'_, N> {
     fn observe_contact(&self, t: f64, modes: &Modes, z: &[f64; N], i: usize) -> Observables {
         self.0.observe_dyn(t, modes, z, i)
     }
+    #[inline]
     fn breakpoint_after(&self, t: f64) -> Option<f64> {
         <Lumped as System<N>>::breakpoint_after(self.0, t)
     }
