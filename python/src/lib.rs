@@ -544,6 +544,13 @@ fn branch(
 /// The compiled module.
 #[pymodule]
 fn _squeal(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // A build for x86-64-v3 (the default) on a processor without AVX2 would
+    // die of an illegal instruction later: refuse the import instead.
+    if let Some(feature) = squeal_study::cpu::missing_feature() {
+        return Err(pyo3::exceptions::PyImportError::new_err(
+            squeal_study::cpu::refusal(feature),
+        ));
+    }
     m.add("SquealError", m.py().get_type::<SquealError>())?;
     m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;
     m.add_function(wrap_pyfunction!(scenarios, m)?)?;

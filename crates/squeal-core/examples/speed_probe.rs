@@ -6,7 +6,7 @@
 //! be checked. `… -- window` runs only the default disc–pad's 0.3 s
 //! event-free window from rest (the run measured under callgrind).
 
-use squeal_core::integrate::ensemble::{simulate_ensemble, Job};
+use squeal_core::integrate::ensemble::{simulate_ensemble, simulate_ensemble_lanes, Job};
 use squeal_core::model::lumped::{disc_pad_spec, Fixed};
 use squeal_core::model::{EventKind, Mode};
 use squeal_core::sink::Discard;
@@ -50,7 +50,7 @@ fn run<M: System<N>, const N: usize>(name: &str, m: &M, z0: [f64; N], t_end: f64
     );
 }
 
-fn lanes(models: &[DiscPad]) -> u64 {
+fn lanes(models: &[DiscPad], lane_field: bool) -> u64 {
     let mut jobs: Vec<Job<'_, DiscPad, Discard, 8>> = models
         .iter()
         .map(|m| Job {
@@ -62,8 +62,12 @@ fn lanes(models: &[DiscPad]) -> u64 {
             sink: Discard,
         })
         .collect();
-    simulate_ensemble::<DiscPad, Discard, 8>(&mut jobs, 200_000.0)
-        .iter()
+    let runs = if lane_field {
+        simulate_ensemble_lanes::<DiscPad, Discard, 8>(&mut jobs, 200_000.0)
+    } else {
+        simulate_ensemble::<DiscPad, Discard, 8>(&mut jobs, 200_000.0)
+    };
+    runs.iter()
         .map(|r| r.as_ref().unwrap().stats.accepted)
         .sum()
 }
@@ -156,11 +160,9 @@ fn main() {
     }
     if what == "lanes" {
         // `lanes L`: 16 disc–pads (V from 0.8 to 1.55 m/s), 0.3 s from rest at
-        // 200 kHz, L at a time (L = 1: `simulate` one after the other).
-        let l: usize = std::env::args()
-            .nth(2)
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(1);
+        // 200 kHz, L at a time (L = 1: `simulate` one after the other; 4: the
+        // ensemble with one field call per lane; 4f: with the lane-wise field).
+        let arg = std::env::args().nth(2).unwrap_or_else(|| "1".into());
         let models: Vec<DiscPad> = (0..16)
             .map(|k| {
                 let mut m = disc;
@@ -169,8 +171,8 @@ fn main() {
             })
             .collect();
         let t = std::time::Instant::now();
-        let steps: u64 = match l {
-            1 => models
+        let steps: u64 = match arg.as_str() {
+            "1" => models
                 .iter()
                 .map(|m| {
                     let o = SolverOptions::default();
@@ -178,11 +180,12 @@ fn main() {
                     i.stats.accepted
                 })
                 .sum(),
-            4 => lanes(&models),
-            _ => panic!("L = 1 or 4"),
+            "4" => lanes(&models, false),
+            "4f" => lanes(&models, true),
+            _ => panic!("L = 1, 4 or 4f"),
         };
         println!(
-            "L = {l}: {steps} steps in {:.3} s",
+            "L = {arg}: {steps} steps in {:.3} s",
             t.elapsed().as_secs_f64()
         );
         return;

@@ -2,13 +2,17 @@
 //! same events, the same outcome and the same samples, bit for bit, also for
 //! lanes that stop early or fail while the others go on.
 
-use squeal_core::integrate::ensemble::{simulate_ensemble, Job};
+use squeal_core::integrate::ensemble::{
+    simulate_ensemble, simulate_ensemble_lanes, Job, LaneField, LANES,
+};
 use squeal_core::model::Mode;
+use squeal_core::model::Modes;
 use squeal_core::sink::Recorder;
 use squeal_core::{
     simulate, Belt, DiscPad, EventKind, Flow, FrictionLaw, IntegrateError, RunInfo, Sink,
     SolverOptions, System,
 };
+use wide::f64x4;
 
 /// A recorder that stops the run after `limit` samples.
 #[derive(Debug, Clone, Default)]
@@ -39,12 +43,17 @@ struct Case<const N: usize> {
     limit: usize,
 }
 
+/// An ensemble runner: [`simulate_ensemble`] or [`simulate_ensemble_lanes`].
+type Ensemble<M, const N: usize> =
+    fn(&mut [Job<'_, M, Upto<N>, N>], f64) -> Vec<Result<RunInfo, IntegrateError>>;
+
 /// Run `cases` on `models` one at a time and as an ensemble of `L` lanes;
 /// assert identical results. Returns the one-at-a-time results.
 fn same_as_single<M: System<N>, const N: usize>(
     models: &[M],
     cases: &[Case<N>],
     rate: f64,
+    ensemble: Ensemble<M, N>,
 ) -> Vec<Result<(RunInfo, Upto<N>), IntegrateError>> {
     let single: Vec<_> = models
         .iter()
@@ -72,7 +81,7 @@ fn same_as_single<M: System<N>, const N: usize>(
             },
         })
         .collect();
-    let together = simulate_ensemble::<M, Upto<N>, N>(&mut jobs, rate);
+    let together = ensemble(&mut jobs, rate);
     assert_eq!(together.len(), single.len());
     for (k, ((one, many), job)) in single.iter().zip(&together).zip(&jobs).enumerate() {
         match (one, many) {
@@ -158,7 +167,20 @@ fn disc_pad_lanes_match_single_runs() {
     soft.p.k_py = 4.0e8;
     push(soft, kicked(1.8), 0.015, opts, usize::MAX);
 
-    let single = same_as_single::<DiscPad, 8>(&models, &cases, 50_000.0);
+    let single = same_as_single::<DiscPad, 8>(&models, &cases, 50_000.0, simulate_ensemble);
+    // The same with the lane-wise right-hand side (the Stribeck lane makes
+    // its lane set fall back to `field`; lanes in stick fall back alone).
+    same_as_single::<DiscPad, 8>(&models, &cases, 50_000.0, simulate_ensemble_lanes);
+    let thesis: Vec<usize> = (0..models.len()).filter(|&k| k != 2).collect();
+    same_as_single::<DiscPad, 8>(
+        &thesis.iter().map(|&k| models[k]).collect::<Vec<_>>(),
+        &thesis
+            .iter()
+            .map(|&k| Case { ..cases[k] })
+            .collect::<Vec<_>>(),
+        50_000.0,
+        simulate_ensemble_lanes,
+    );
     // The cases are what they claim to be.
     let ok: Vec<_> = single.iter().filter_map(|r| r.as_ref().ok()).collect();
     assert!(
@@ -180,7 +202,8 @@ fn disc_pad_lanes_match_single_runs() {
         "{reversals} reversals, {sticks} sticks"
     );
     // Fewer jobs than lanes.
-    same_as_single::<DiscPad, 8>(&models[..2], &cases[..2], 50_000.0);
+    same_as_single::<DiscPad, 8>(&models[..2], &cases[..2], 50_000.0, simulate_ensemble);
+    same_as_single::<DiscPad, 8>(&models[..2], &cases[..2], 50_000.0, simulate_ensemble_lanes);
 }
 
 /// The mass on a belt with Coulomb stick-slip (exact sticks and slips),
@@ -206,10 +229,82 @@ fn belt_lanes_match_single_runs() {
             limit: if k == 3 { 150 } else { usize::MAX },
         });
     }
-    let single = same_as_single::<Belt, 2>(&models, &cases, 1000.0);
+    let single = same_as_single::<Belt, 2>(&models, &cases, 1000.0, simulate_ensemble);
     let sticking = single
         .iter()
         .filter(|r| r.as_ref().unwrap().0.stats.event_count(EventKind::Stick) > 0)
         .count();
     assert!(sticking >= 8, "{sticking} of 11 runs stick");
+}
+
+/// The disc–pad's lane-wise right-hand side equals `field` lane by lane, bit
+/// for bit, in both slip directions, for four different models (speeds,
+/// loads, follower force, a ramp in progress and one finished); it leaves
+/// stick and free flight to `field`, and other friction laws altogether.
+#[test]
+fn disc_pad_lane_field_is_field_bit_for_bit() {
+    let mut models = [DiscPad::default(); LANES];
+    models[1].p.V = 2.5;
+    models[1].p.N = 1800.0;
+    models[2].p.alpha = 3.0;
+    models[2].p.t_ramp = 0.01;
+    models[3].p.t_ramp = 1e-4;
+    models[3].p.c_py = 7.0;
+    let pack = DiscPad::pack(models.each_ref().map(Some)).expect("thesis law, unilateral");
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut rnd = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let scale = [1e-6, 1e-6, 1e-6, 1e-6, 2.0, 2.0, 1.0, 1.0];
+    for case in 0..2000 {
+        let z: [[f64; 8]; LANES] =
+            std::array::from_fn(|_| std::array::from_fn(|i| scale[i] * rnd()));
+        let t: [f64; LANES] = std::array::from_fn(|_| 0.01 * rnd().abs());
+        let modes: [Mode; LANES] = std::array::from_fn(|l| {
+            if (case + l) % 3 == 0 {
+                Mode::SlipNeg
+            } else {
+                Mode::SlipPos
+            }
+        });
+        let zl: [f64x4; 8] = std::array::from_fn(|i| f64x4::new(std::array::from_fn(|l| z[l][i])));
+        let mut dz = [f64x4::ZERO; 8];
+        let lane_modes = modes.map(|m| Some(Modes::single(m)));
+        let done = DiscPad::field_lanes(&pack, f64x4::new(t), &lane_modes, &zl, &mut dz);
+        assert_eq!(done, [true; LANES]);
+        for l in 0..LANES {
+            let mut one = [0.0; 8];
+            models[l].field(t[l], &Modes::single(modes[l]), &z[l], &mut one);
+            for i in 0..8 {
+                assert_eq!(
+                    dz[i].as_array_ref()[l].to_bits(),
+                    one[i].to_bits(),
+                    "case {case} lane {l} state {i}: {} vs {}",
+                    dz[i].as_array_ref()[l],
+                    one[i]
+                );
+            }
+        }
+    }
+    // Idle lanes are not computed; lanes in stick or free flight are left
+    // to `field`, the others are computed.
+    let zl = [f64x4::ZERO; 8];
+    let mut dz = [f64x4::ZERO; 8];
+    let mut lane_modes = [None; LANES];
+    lane_modes[0] = Some(Modes::single(Mode::SlipPos));
+    let done = DiscPad::field_lanes(&pack, f64x4::ZERO, &lane_modes, &zl, &mut dz);
+    assert_eq!(done, [true, false, false, false]);
+    lane_modes[1] = Some(Modes::single(Mode::Stick));
+    lane_modes[2] = Some(Modes::single(Mode::Free));
+    let done = DiscPad::field_lanes(&pack, f64x4::ZERO, &lane_modes, &zl, &mut dz);
+    assert_eq!(done, [true, false, false, false]);
+    lane_modes[0] = None;
+    let done = DiscPad::field_lanes(&pack, f64x4::ZERO, &lane_modes, &zl, &mut dz);
+    assert_eq!(done, [false; LANES]);
+    let mut strib = models;
+    strib[3].friction = FrictionLaw::by_name("stribeck").unwrap();
+    assert!(DiscPad::pack(strib.each_ref().map(Some)).is_none());
 }

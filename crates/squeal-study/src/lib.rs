@@ -9,6 +9,7 @@
 
 pub mod analysis;
 pub mod branch;
+pub mod cpu;
 pub mod critical;
 pub mod cycle;
 pub mod error;

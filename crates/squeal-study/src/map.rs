@@ -13,13 +13,19 @@ use crate::error::{Cancel, Progress, StudyError};
 use crate::model::AnyModel;
 use crate::scenario::{InputError, Scenario};
 use rayon::prelude::*;
+use squeal_core::integrate::ensemble::{simulate_ensemble_lanes, Job};
 use squeal_core::integrate::{Flow, Sink};
 use squeal_core::stability::StabilityError;
-use squeal_core::System;
-use squeal_core::{simulate, EventKind, Mode};
+use squeal_core::{simulate, EventKind, IntegrateError, Mode, RunInfo};
+use squeal_core::{DiscPad, System};
 
 /// Points per progress report of a linear grid.
 const CHUNK: usize = 256;
+
+/// Points per task of a transient grid: a task's disc–pad points run four
+/// at a time on its core ([`simulate_ensemble_lanes`]; a lane whose point
+/// is decided takes the task's next point), the others one by one.
+const TRANSIENT_CHUNK: usize = 16;
 
 /// One grid axis.
 #[derive(Debug, Clone, PartialEq)]
@@ -267,10 +273,11 @@ impl<const N: usize> Sink<N> for Watch {
     }
 }
 
-fn transient_point<M: System<N>, const N: usize>(
+/// The sink that watches a transient run of `model`, and its start.
+fn watch_for<M: System<N>, const N: usize>(
     model: &M,
     sc: &Scenario,
-) -> Result<Outcome, String> {
+) -> Result<(Watch, [f64; N]), String> {
     let names = model.names();
     let idx: Vec<usize> = (N / 2..N)
         .filter(|&i| names[i].starts_with("vx") || names[i] == "v")
@@ -278,7 +285,7 @@ fn transient_point<M: System<N>, const N: usize>(
     let v_idx = *idx.first().ok_or("no tangential velocity")?;
     let z0 = crate::run::initial_of(model, sc).map_err(|e| e.to_string())?;
     let window = sc.duration / 50.0;
-    let mut w = Watch {
+    let w = Watch {
         idx,
         v_idx,
         window,
@@ -294,18 +301,12 @@ fn transient_point<M: System<N>, const N: usize>(
         decided: None,
         validity: sc.validity,
     };
-    // Each window's peak is taken over the scenario's samples: at 200 kHz it is
-    // within a few % of the envelope, which is all a class needs.
-    let info = simulate(
-        model,
-        0.0,
-        z0,
-        sc.duration,
-        sc.sample_rate,
-        crate::run::sim_options::<N>(sc),
-        &mut w,
-    )
-    .map_err(|e| e.to_string())?;
+    Ok((w, z0))
+}
+
+/// The outcome of a watched run that ended with `info`.
+fn classify(w: &Watch, info: Result<RunInfo, IntegrateError>) -> Result<Outcome, String> {
+    let info = info.map_err(|e| e.to_string())?;
     let class = w.decided.unwrap_or_else(|| {
         let n = w.amps.len();
         if n < 6 {
@@ -331,11 +332,32 @@ fn transient_point<M: System<N>, const N: usize>(
     })
 }
 
+fn transient_point<M: System<N>, const N: usize>(
+    model: &M,
+    sc: &Scenario,
+) -> Result<Outcome, String> {
+    let (mut w, z0) = watch_for(model, sc)?;
+    // Each window's peak is taken over the scenario's samples: at 200 kHz it is
+    // within a few % of the envelope, which is all a class needs.
+    let info = simulate(
+        model,
+        0.0,
+        z0,
+        sc.duration,
+        sc.sample_rate,
+        crate::run::sim_options::<N>(sc),
+        &mut w,
+    );
+    classify(&w, info)
+}
+
 /// Transient map over `points` (flat indices, see [`point`]): one
 /// simulation per point, stopped early once its class is certain; one
 /// [`Outcome`] per point in the order given (`failed` where the point
-/// cannot run). `progress` counts points; `cancel` is looked at before
-/// every point and ends the map with [`StudyError::Interrupted`].
+/// cannot run). The points go in tasks of 16, whose
+/// disc–pads run as an ensemble on one core (the same bits as one at a
+/// time). `progress` counts points; `cancel` is looked at before every task
+/// and ends the map with [`StudyError::Interrupted`].
 pub fn transient_grid(
     sc: &Scenario,
     x: &Axis,
@@ -344,38 +366,87 @@ pub fn transient_grid(
     progress: &dyn Progress,
     cancel: &Cancel,
 ) -> Result<Vec<Outcome>, StudyError> {
-    let out: Vec<Outcome> = points
-        .par_iter()
-        .map(|&k| {
+    let out: Vec<Vec<Outcome>> = points
+        .par_chunks(TRANSIENT_CHUNK)
+        .map(|chunk| {
             if cancel.is_cancelled() {
-                return Outcome::FAILED;
+                return vec![Outcome::FAILED; chunk.len()];
             }
-            let o = transient_at(sc, x, y, k);
-            progress.inc(1);
+            let o = transient_chunk(sc, x, y, chunk);
+            progress.inc(chunk.len() as u64);
             o
         })
         .collect();
     cancel.check()?;
-    Ok(out)
+    Ok(out.concat())
 }
 
-/// One point of [`transient_grid`].
-pub fn transient_at(sc: &Scenario, x: &Axis, y: &Axis, k: usize) -> Outcome {
+/// The points of one task of [`transient_grid`]: each exactly as
+/// [`transient_at`] computes it (the ensemble's runs are bit for bit the
+/// single runs), the disc–pads four at a time.
+fn transient_chunk(sc: &Scenario, x: &Axis, y: &Axis, chunk: &[usize]) -> Vec<Outcome> {
+    let mut out = vec![Outcome::FAILED; chunk.len()];
+    let mut discs: Vec<(usize, Scenario)> = Vec::new();
+    for (n, &k) in chunk.iter().enumerate() {
+        match prepared(sc, x, y, k) {
+            Ok(s) if matches!(s.model, AnyModel::DiscPad(_)) && s.sample_rate == sc.sample_rate => {
+                discs.push((n, s))
+            }
+            Ok(s) => out[n] = run_prepared(&s).unwrap_or(Outcome::FAILED),
+            Err(_) => {}
+        }
+    }
+    let mut jobs: Vec<Job<'_, DiscPad, Watch, 8>> = Vec::new();
+    let mut slots = Vec::new();
+    for (n, s) in &discs {
+        let AnyModel::DiscPad(m) = &s.model else {
+            continue;
+        };
+        if let Ok((sink, z0)) = watch_for(m, s) {
+            jobs.push(Job {
+                model: m,
+                t0: 0.0,
+                z0,
+                t_end: s.duration,
+                opts: crate::run::sim_options::<8>(s),
+                sink,
+            });
+            slots.push(*n);
+        }
+    }
+    let results = simulate_ensemble_lanes(&mut jobs, sc.sample_rate);
+    for ((job, r), n) in jobs.iter().zip(results).zip(slots) {
+        out[n] = classify(&job.sink, r).unwrap_or(Outcome::FAILED);
+    }
+    out
+}
+
+/// The scenario of point `k`: both parameters set, validated, and checked
+/// for a simulated run (its own step budget).
+fn prepared(sc: &Scenario, x: &Axis, y: &Axis, k: usize) -> Result<Scenario, String> {
     let (i, j) = point(x, k);
     let mut s = sc.clone();
-    let r = s
-        .model
+    s.model
         .set(&x.name, x.values[i])
         .and_then(|_| s.model.set(&y.name, y.values[j]))
         .and_then(|_| s.model.validate())
         .map_err(|e| e.to_string())
         // Each point gets its own step budget (its stiffness differs).
-        .and_then(|_| crate::feasible::prepare(&mut s).map_err(|e| e.to_string()))
-        .and_then(|_| {
-            crate::with_sim_system!(&s.model, m => transient_point(m, &s),
-            else => Err(s.model.check_simulable().err().unwrap_or_default()))
-        });
-    r.unwrap_or(Outcome::FAILED)
+        .and_then(|_| crate::feasible::prepare(&mut s).map_err(|e| e.to_string()))?;
+    Ok(s)
+}
+
+/// The transient run of a prepared point, one at a time.
+fn run_prepared(s: &Scenario) -> Result<Outcome, String> {
+    crate::with_sim_system!(&s.model, m => transient_point(m, s),
+        else => Err(s.model.check_simulable().err().unwrap_or_default()))
+}
+
+/// One point of [`transient_grid`].
+pub fn transient_at(sc: &Scenario, x: &Axis, y: &Axis, k: usize) -> Outcome {
+    prepared(sc, x, y, k)
+        .and_then(|s| run_prepared(&s))
+        .unwrap_or(Outcome::FAILED)
 }
 
 /// Do the linear verdict (σ) and the simulated outcome tell the same story?

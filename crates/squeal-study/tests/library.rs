@@ -82,6 +82,43 @@ fn transient_grid_points_are_the_same_in_any_subset() {
     }
 }
 
+/// A transient grid runs its disc–pad points four at a time (the ensemble
+/// with the lane-wise right-hand side); every point's outcome is bit for bit
+/// the one-at-a-time run's (`transient_at`), for points that grow, stay
+/// steady and stick-slip (lanes in stick use the per-lane field), in a grid
+/// larger than one task (16) with points repeated.
+#[test]
+fn transient_grid_equals_one_point_at_a_time() {
+    let sc = resolve_run(Source::Spec("disc-pad"), &["c_px=2".into()], Some(0.04)).unwrap();
+    let x = map::parse_axis("V=0.3:9:6", "--x", false, &sc.model).unwrap();
+    let y = map::parse_axis("N=0:4000:3", "--y", false, &sc.model).unwrap();
+    let all = map::all_points(&x, &y);
+    let mut points = all.clone();
+    points.extend(all.iter().rev().take(5));
+    let grid = map::transient_grid(&sc, &x, &y, &points, &NoProgress, &Cancel::new()).unwrap();
+    assert_eq!(grid.len(), points.len());
+    for (k, o) in points.iter().zip(&grid) {
+        let one = map::transient_at(&sc, &x, &y, *k);
+        assert_eq!(one.class, o.class, "point {k}");
+        for (a, b) in [
+            (one.rms, o.rms),
+            (one.t_end, o.t_end),
+            (one.stick_fraction, o.stick_fraction),
+        ] {
+            assert_eq!(a.to_bits(), b.to_bits(), "point {k}: {a} vs {b}");
+        }
+    }
+    let classes: std::collections::BTreeSet<&str> = grid.iter().map(|o| o.class).collect();
+    assert!(
+        classes.contains("grows") && classes.contains("stick-slip"),
+        "{classes:?}"
+    );
+    assert!(
+        grid.iter().any(|o| o.stick_fraction > 0.0),
+        "a point sticks"
+    );
+}
+
 #[test]
 fn a_set_cancel_token_interrupts_runs_and_grids() {
     let cancel = Cancel::new();

@@ -71,6 +71,19 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Before anything else runs: a build for x86-64-v3 (the default) on a
+    // processor without AVX2 would otherwise die of an illegal instruction.
+    if let Some(feature) = squeal_study::cpu::missing_feature() {
+        eprintln!("error: {}", squeal_study::cpu::refusal(feature));
+        return ExitCode::from(1);
+    }
+    run_cli()
+}
+
+/// The command line proper (not inlined into `main`, so that the check of the
+/// processor comes before any of its code).
+#[inline(never)]
+fn run_cli() -> ExitCode {
     staging::install_signal_handlers();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,

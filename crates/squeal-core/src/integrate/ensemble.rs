@@ -8,20 +8,23 @@
 //! layout (`[stage][state][lane]`) whose innermost loop runs across lanes.
 //! Each lane's numbers go through the same operations in the same order as
 //! in a run of its own, so the ensemble's results are bit-for-bit those of
-//! one-at-a-time runs. What it could gain: the lanes' right-hand sides are
+//! one-at-a-time runs. What it gains: the lanes' right-hand sides are
 //! independent, so the processor overlaps their latencies, which a single
-//! trajectory's serial chain of stages cannot do. Measured (BENCHMARKS.md,
-//! issue 16): 11 % slower per run than one at a time on the baseline
-//! x86-64 target, where one trajectory's 8 states already fill the 2-wide
-//! vectors and each lane's right-hand side is still called on its own;
-//! 5 % faster for x86-64-v3. Not used by the CLI for that reason.
+//! trajectory's serial chain of stages cannot do, and with AVX2 a stage
+//! combination serves four lanes per instruction. With each lane's
+//! right-hand side called on its own ([`simulate_ensemble`]) that is eaten
+//! by copying states and slopes in and out of the lanes; with a model's
+//! lane-wise [`LaneField`] ([`simulate_ensemble_lanes`]) the disc–pad runs
+//! 1.25–1.45× as many steps per CPU-second as one at a time on the default
+//! x86-64-v3 build (BENCHMARKS.md, issue 16). Transient maps of the
+//! disc–pad use it.
 //!
 //! A lane whose run ends (finished, stopped by its sink, or failed) takes
 //! the next job at once, so a sweep of many short runs keeps all lanes busy.
 
 use super::tableau::{A, B, C, D, E3, E5};
 use super::{check_rate, Feed, IntegrateError, RunInfo, Sink, Solver, SolverOptions};
-use crate::model::System;
+use crate::model::{Modes, System};
 use wide::f64x4;
 
 /// Lanes of an ensemble: one [`f64x4`] holds a number of each.
@@ -42,6 +45,95 @@ pub struct Job<'m, M: System<N> + ?Sized, S: Sink<N>, const N: usize> {
     pub opts: SolverOptions,
     /// Where the samples and events go.
     pub sink: S,
+}
+
+/// A right-hand side evaluated for [`LANES`] runs at once, lane-wise, for
+/// [`simulate_ensemble_lanes`]: the stage combinations already run across
+/// lanes; with this the slopes do too, and no lane's state is copied out of
+/// (or its slope into) the lane-wise arrays.
+///
+/// The contract is [`System::field`]'s, lane by lane and bit for bit: each
+/// lane's slope must come from the same IEEE operations in the same order as
+/// `field` on that lane's model, state and time (lane-wise products, sums
+/// and quotients of [`f64x4`] are the scalar ones). A call may leave lanes
+/// out (e.g. a mode it does not cover): those lanes are then evaluated by
+/// [`System::field`].
+pub trait LaneField<const N: usize>: System<N> + Sized {
+    /// What the lane-wise field needs of the lanes' models, gathered once
+    /// per change of the lanes' jobs (not on every call).
+    type Pack;
+    /// The pack of the lanes' models (`None`: an empty lane); `None` if these
+    /// models cannot be evaluated lane-wise (every call then falls back to
+    /// [`System::field`]).
+    fn pack(models: [Option<&Self>; LANES]) -> Option<Self::Pack>;
+    /// `dz = f(t, z)` lane by lane, each lane in its own `modes`
+    /// (`None`: an idle lane, whose `dz` is not used). Returns the lanes it
+    /// computed; the others' `dz` may hold anything (they are computed
+    /// again by [`System::field`]).
+    fn field_lanes(
+        pack: &Self::Pack,
+        t: f64x4,
+        modes: &[Option<Modes>; LANES],
+        z: &[f64x4; N],
+        dz: &mut [f64x4; N],
+    ) -> [bool; LANES];
+}
+
+/// How the lanes' slopes are computed: one model call per lane
+/// ([`PerLane`]), or a [`LaneField`] for all lanes at once ([`Packed`]).
+trait Slopes<M: System<N> + ?Sized, const N: usize> {
+    /// The lanes' jobs changed: gather what the lane-wise field needs.
+    fn repack(&mut self, lanes: &[Option<Lane<'_, M, N>>; L]);
+    /// The slopes at `(t, z)` of the lanes with `modes` in `dz`; returns
+    /// the lanes computed (the others are left to [`System::field`]).
+    fn lanes(
+        &self,
+        t: f64x4,
+        modes: &[Option<Modes>; L],
+        z: &[f64x4; N],
+        dz: &mut [f64x4; N],
+    ) -> [bool; L];
+}
+
+/// Every lane's slope by its own model call.
+struct PerLane;
+
+impl<M: System<N> + ?Sized, const N: usize> Slopes<M, N> for PerLane {
+    fn repack(&mut self, _lanes: &[Option<Lane<'_, M, N>>; L]) {}
+    #[inline(always)]
+    fn lanes(
+        &self,
+        _t: f64x4,
+        _modes: &[Option<Modes>; L],
+        _z: &[f64x4; N],
+        _dz: &mut [f64x4; N],
+    ) -> [bool; L] {
+        [false; L]
+    }
+}
+
+/// The lanes' slopes by the model's [`LaneField`].
+struct Packed<M: LaneField<N>, const N: usize>(Option<M::Pack>);
+
+impl<M: LaneField<N>, const N: usize> Slopes<M, N> for Packed<M, N> {
+    fn repack(&mut self, lanes: &[Option<Lane<'_, M, N>>; L]) {
+        self.0 = M::pack(std::array::from_fn(|l| {
+            lanes[l].as_ref().map(|lane| lane.solver.model)
+        }));
+    }
+    #[inline(always)]
+    fn lanes(
+        &self,
+        t: f64x4,
+        modes: &[Option<Modes>; L],
+        z: &[f64x4; N],
+        dz: &mut [f64x4; N],
+    ) -> [bool; L] {
+        match &self.0 {
+            Some(pack) => M::field_lanes(pack, t, modes, z, dz),
+            None => [false; L],
+        }
+    }
 }
 
 /// A lane at work: its job's index, solver, feed, and the step in progress.
@@ -66,6 +158,34 @@ where
     M: System<N> + ?Sized,
     S: Sink<N>,
 {
+    run_ensemble(jobs, sample_rate, PerLane)
+}
+
+/// [`simulate_ensemble`] with the slopes of every stage computed for all
+/// lanes at once by the model's [`LaneField`] (falling back to one call per
+/// lane where it declines): the same results, bit for bit.
+pub fn simulate_ensemble_lanes<'m, M, S, const N: usize>(
+    jobs: &mut [Job<'m, M, S, N>],
+    sample_rate: f64,
+) -> Vec<Result<RunInfo, IntegrateError>>
+where
+    M: LaneField<N>,
+    S: Sink<N>,
+{
+    run_ensemble(jobs, sample_rate, Packed::<M, N>(None))
+}
+
+/// The ensemble's loop, with the lanes' slopes computed by `slopes`.
+fn run_ensemble<'m, M, S, F, const N: usize>(
+    jobs: &mut [Job<'m, M, S, N>],
+    sample_rate: f64,
+    mut slopes: F,
+) -> Vec<Result<RunInfo, IntegrateError>>
+where
+    M: System<N> + ?Sized,
+    S: Sink<N>,
+    F: Slopes<M, N>,
+{
     let mut results: Vec<Option<Result<RunInfo, IntegrateError>>> =
         (0..jobs.len()).map(|_| None).collect();
     if let Err(e) = check_rate(sample_rate) {
@@ -74,6 +194,8 @@ where
     let mut lanes: [Option<Lane<'m, M, N>>; L] = std::array::from_fn(|_| None);
     let mut next_job = 0;
     let mut soa = Soa::<N>::new();
+    // The job of each lane when the slopes were last packed.
+    let mut packed_jobs = [None; L];
     loop {
         // Fill idle lanes, start their steps and size their attempts; a lane
         // whose run ends here is emptied and filled again.
@@ -114,8 +236,13 @@ where
         if !active.contains(&true) {
             break;
         }
+        let jobs_now = std::array::from_fn(|l| lanes[l].as_ref().map(|lane| lane.job));
+        if jobs_now != packed_jobs {
+            slopes.repack(&lanes);
+            packed_jobs = jobs_now;
+        }
         // One attempt of every active lane, together.
-        soa.attempt(&mut lanes, &active);
+        soa.attempt(&mut lanes, &active, &slopes);
         let mut accepted = [false; L];
         for l in 0..L {
             if !active[l] {
@@ -135,7 +262,7 @@ where
         if !accepted.contains(&true) {
             continue;
         }
-        soa.dense_stages(&mut lanes, &accepted);
+        soa.dense_stages(&mut lanes, &accepted, &slopes);
         for l in 0..L {
             if !accepted[l] {
                 continue;
@@ -252,33 +379,52 @@ impl<const N: usize> Soa<N> {
     /// Stage `S` of every lane in `mask`: its state from the earlier
     /// stages (all lanes at once), its slope from the lane's own model.
     #[inline(always)]
-    fn stage<M: System<N> + ?Sized, const S: usize>(
+    fn stage<M: System<N> + ?Sized, F: Slopes<M, N>, const S: usize>(
         &mut self,
         lanes: &mut [Option<Lane<'_, M, N>>; L],
         mask: &[bool; L],
+        f: &F,
     ) {
         let y = combine_lanes::<N, S>(&self.k, &self.z, &A[S], self.h);
-        self.slopes(lanes, mask, S, &y, C[S]);
+        self.slopes(lanes, mask, S, &y, C[S], f);
     }
 
     /// `k[s] = f(t + c·h, y)` of every lane in `mask` (0 elsewhere). Not
     /// inlined: one copy of the right-hand side serves every stage, so the
     /// code stays within the instruction cache.
     #[inline(never)]
-    fn slopes<M: System<N> + ?Sized>(
+    fn slopes<M: System<N> + ?Sized, F: Slopes<M, N>>(
         &mut self,
         lanes: &mut [Option<Lane<'_, M, N>>; L],
         mask: &[bool; L],
         s: usize,
         y: &[f64x4; N],
         c: f64,
+        f: &F,
     ) {
+        // The lanes' times, lane-wise: the same sums as below.
+        let t = f64x4::new(self.t);
+        let tc = if s == 12 {
+            t + self.h
+        } else {
+            t + f64x4::splat(c) * self.h
+        };
+        let modes: [Option<Modes>; L] = std::array::from_fn(|l| match (&lanes[l], mask[l]) {
+            (Some(lane), true) => Some(lane.solver.modes),
+            _ => None,
+        });
+        let done = f.lanes(tc, &modes, y, &mut self.k[s]);
         let h = self.h.to_array();
         let mut out = [[0.0; N]; L];
+        let mut rest = [false; L];
         for (l, lane) in lanes.iter_mut().enumerate() {
             if let (Some(lane), true) = (lane, mask[l]) {
                 let solver = &mut lane.solver;
                 solver.stats.rhs_evals += 1;
+                if done[l] {
+                    continue;
+                }
+                rest[l] = true;
                 let tc = if s == 12 {
                     self.t[l] + h[l]
                 } else {
@@ -289,17 +435,29 @@ impl<const N: usize> Soa<N> {
                     .field(tc, &solver.modes, &lane_of(y, l), &mut out[l]);
             }
         }
-        for i in 0..N {
-            self.k[s][i] = f64x4::new(std::array::from_fn(|l| out[l][i]));
+        // The lanes evaluated one by one go in with one vector per state
+        // (not lane by lane: a vector rebuilt from four scalar stores).
+        if rest.contains(&true) {
+            for i in 0..N {
+                let done_i = self.k[s][i].to_array();
+                self.k[s][i] = f64x4::new(std::array::from_fn(|l| {
+                    if rest[l] {
+                        out[l][i]
+                    } else {
+                        done_i[l]
+                    }
+                }));
+            }
         }
     }
 
     /// One attempt of every active lane (its size is in the lane): stages
     /// 1…12 as [`Solver::rk_step`] computes them, and the error estimates.
-    fn attempt<M: System<N> + ?Sized>(
+    fn attempt<M: System<N> + ?Sized, F: Slopes<M, N>>(
         &mut self,
         lanes: &mut [Option<Lane<'_, M, N>>; L],
         active: &[bool; L],
+        fields: &F,
     ) {
         let mut h = [0.0; L];
         let mut z = [[0.0; N]; L];
@@ -317,19 +475,19 @@ impl<const N: usize> Soa<N> {
             self.z[i] = f64x4::new(std::array::from_fn(|l| z[l][i]));
             self.k[0][i] = f64x4::new(std::array::from_fn(|l| f[l][i]));
         }
-        self.stage::<M, 1>(lanes, active);
-        self.stage::<M, 2>(lanes, active);
-        self.stage::<M, 3>(lanes, active);
-        self.stage::<M, 4>(lanes, active);
-        self.stage::<M, 5>(lanes, active);
-        self.stage::<M, 6>(lanes, active);
-        self.stage::<M, 7>(lanes, active);
-        self.stage::<M, 8>(lanes, active);
-        self.stage::<M, 9>(lanes, active);
-        self.stage::<M, 10>(lanes, active);
-        self.stage::<M, 11>(lanes, active);
+        self.stage::<M, F, 1>(lanes, active, fields);
+        self.stage::<M, F, 2>(lanes, active, fields);
+        self.stage::<M, F, 3>(lanes, active, fields);
+        self.stage::<M, F, 4>(lanes, active, fields);
+        self.stage::<M, F, 5>(lanes, active, fields);
+        self.stage::<M, F, 6>(lanes, active, fields);
+        self.stage::<M, F, 7>(lanes, active, fields);
+        self.stage::<M, F, 8>(lanes, active, fields);
+        self.stage::<M, F, 9>(lanes, active, fields);
+        self.stage::<M, F, 10>(lanes, active, fields);
+        self.stage::<M, F, 11>(lanes, active, fields);
         let z_new = combine_lanes::<N, 12>(&self.k, &self.z, &B, self.h);
-        self.slopes(lanes, active, 12, &z_new, 1.0);
+        self.slopes(lanes, active, 12, &z_new, 1.0, fields);
         self.z_new = z_new;
         let zero = [f64x4::ZERO; N];
         let one = f64x4::splat(1.0);
@@ -363,14 +521,15 @@ impl<const N: usize> Soa<N> {
     /// The dense output's three extra stages of the accepted lanes and its
     /// high-order coefficients, copied into their solvers (with the slopes
     /// at both ends of the step).
-    fn dense_stages<M: System<N> + ?Sized>(
+    fn dense_stages<M: System<N> + ?Sized, F: Slopes<M, N>>(
         &mut self,
         lanes: &mut [Option<Lane<'_, M, N>>; L],
         accepted: &[bool; L],
+        f: &F,
     ) {
-        self.stage::<M, 13>(lanes, accepted);
-        self.stage::<M, 14>(lanes, accepted);
-        self.stage::<M, 15>(lanes, accepted);
+        self.stage::<M, F, 13>(lanes, accepted, f);
+        self.stage::<M, F, 14>(lanes, accepted, f);
+        self.stage::<M, F, 15>(lanes, accepted, f);
         let zero = [f64x4::ZERO; N];
         let d: [[f64x4; N]; 4] = [
             combine_lanes::<N, 16>(&self.k, &zero, &D[0], self.h),

@@ -4,12 +4,15 @@
 //!
 //! State `z = (x_d, x_p, y_d, y_p, ẋ_d, ẋ_p, ẏ_d, ẏ_p)`.
 
+use super::Modes;
 use super::{
     contact, stick_or_slip, EventKind, GuardKind, Guards, Mode, Model, ModelError, Observables,
     Parameters,
 };
 use crate::friction::FrictionLaw;
+use crate::integrate::ensemble::{LaneField, LANES};
 use crate::params::{ParamError, ParamKind, ParamSpec};
+use wide::{f64x4, CmpGt, CmpLt};
 
 /// Unilateral (the pad can lift off) or bilateral (never opens) contact.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -544,5 +547,122 @@ impl Model<8> for DiscPad {
         j[WD][YD] -= p.k_dy / p.m_d;
         j[WD][WD] -= p.c_dy / p.m_d;
         j
+    }
+}
+
+/// The parameters of four disc–pads, lane by lane, for
+/// [`LaneField::field_lanes`] (gathered once per change of the lanes' jobs).
+#[derive(Debug, Clone, Copy)]
+pub struct DiscPadLanes {
+    neg_k_dx: f64x4,
+    c_dx: f64x4,
+    neg_k_dy: f64x4,
+    c_dy: f64x4,
+    neg_k_px: f64x4,
+    c_px: f64x4,
+    k_py: f64x4,
+    c_py: f64x4,
+    n: f64x4,
+    v: f64x4,
+    alpha: f64x4,
+    t_ramp: f64x4,
+    inv_md: f64x4,
+    inv_mp: f64x4,
+    f0: f64x4,
+    f1: f64x4,
+    two_uc: f64x4,
+}
+
+/// Lane-wise [`Model::rhs`] in slip (either sign) with the thesis friction
+/// law and unilateral contact (the default; any other law or contact: no
+/// pack, every lane one by one). Lanes in stick or free flight are left to
+/// `rhs`. Each lane's slope comes from the same operations, in the same
+/// order, as `rhs` (tested bit for bit).
+impl LaneField<8> for DiscPad {
+    type Pack = DiscPadLanes;
+
+    fn pack(models: [Option<&Self>; LANES]) -> Option<DiscPadLanes> {
+        let first = models.iter().flatten().next()?;
+        let mut lanes = [**first; LANES];
+        for (lane, m) in lanes.iter_mut().zip(models) {
+            if let Some(m) = m {
+                *lane = *m;
+            }
+        }
+        let mut thesis = [(0.0, 0.0, 0.0); LANES];
+        for (l, m) in lanes.iter().enumerate() {
+            match (m.friction, m.contact) {
+                (FrictionLaw::Thesis { f0, f1, uc }, Contact::Unilateral) => {
+                    thesis[l] = (f0, f1, 2.0 * uc)
+                }
+                _ => return None,
+            }
+        }
+        let get = |f: &dyn Fn(&DiscPad) -> f64| f64x4::new(std::array::from_fn(|l| f(&lanes[l])));
+        Some(DiscPadLanes {
+            neg_k_dx: get(&|m| -m.p.k_dx),
+            c_dx: get(&|m| m.p.c_dx),
+            neg_k_dy: get(&|m| -m.p.k_dy),
+            c_dy: get(&|m| m.p.c_dy),
+            neg_k_px: get(&|m| -m.p.k_px),
+            c_px: get(&|m| m.p.c_px),
+            k_py: get(&|m| m.p.k_py),
+            c_py: get(&|m| m.p.c_py),
+            n: get(&|m| m.p.N),
+            v: get(&|m| m.p.V),
+            alpha: get(&|m| m.p.alpha),
+            t_ramp: get(&|m| m.p.t_ramp),
+            inv_md: get(&|m| 1.0 / m.p.m_d),
+            inv_mp: get(&|m| 1.0 / m.p.m_p),
+            f0: f64x4::new(std::array::from_fn(|l| thesis[l].0)),
+            f1: f64x4::new(std::array::from_fn(|l| thesis[l].1)),
+            two_uc: f64x4::new(std::array::from_fn(|l| thesis[l].2)),
+        })
+    }
+
+    #[inline(always)]
+    fn field_lanes(
+        p: &DiscPadLanes,
+        t: f64x4,
+        modes: &[Option<Modes>; LANES],
+        z: &[f64x4; 8],
+        dz: &mut [f64x4; 8],
+    ) -> [bool; LANES] {
+        let mut neg = [0.0; LANES];
+        let mut done = [false; LANES];
+        for (l, m) in modes.iter().enumerate() {
+            match m.map(|m| m.first()) {
+                Some(Mode::SlipPos) => done[l] = true,
+                Some(Mode::SlipNeg) => (neg[l], done[l]) = (1.0, true),
+                _ => {}
+            }
+        }
+        if !done.contains(&true) {
+            return done;
+        }
+        let zero = f64x4::ZERO;
+        let neg = f64x4::new(neg).cmp_gt(zero);
+        // As `rhs`: F_y (thesis 8.5), v (8.8), s·μ(s·v) with the sign as a
+        // negation, F_t = s·μ·F_y, F_f = α·F_t·y_d.
+        let f_y = p.k_py * (z[YD] - z[YP]) + p.c_py * (z[WD] - z[WP]);
+        let v = p.v + z[UD] - z[UP];
+        let sv = neg.blend(-v, v);
+        let one = f64x4::splat(1.0);
+        let mu = p.f0 * (one - p.f1 * sv * (one - sv / p.two_uc));
+        let s_mu = neg.blend(-mu, mu);
+        let f_t = s_mu * f_y;
+        let f_f = p.alpha * f_t * z[YD];
+        // normal_load: N·max(t/t_ramp, 0) during the ramp, else N.
+        let ramping = p.t_ramp.cmp_gt(zero) & t.cmp_lt(p.t_ramp);
+        let load = ramping.blend(p.n * (t / p.t_ramp).max(zero), p.n);
+        dz[XD] = z[UD];
+        dz[XP] = z[UP];
+        dz[YD] = z[WD];
+        dz[YP] = z[WP];
+        dz[UD] = (p.neg_k_dx * z[XD] - p.c_dx * z[UD] - f_t) * p.inv_md;
+        dz[UP] = (p.neg_k_px * z[XP] - p.c_px * z[UP] + f_t) * p.inv_mp;
+        dz[WD] = (p.neg_k_dy * z[YD] - p.c_dy * z[WD] - f_y + f_f) * p.inv_md;
+        dz[WP] = (f_y - load - f_f) * p.inv_mp;
+        done
     }
 }
