@@ -2,7 +2,7 @@
 //!
 //! The integrator works on fixed-size state arrays (`[f64; N]`), compiled
 //! once per size. Models of up to [`MAX_EXACT_DOFS`] dofs get their own size;
-//! a larger one (up to [`MAX_SIM_DOFS`]) runs in the next of a few padded
+//! a larger one (up to [`MAX_SIM_DOFS`](super::MAX_SIM_DOFS)) runs in the next of a few padded
 //! sizes ([`PADDED_DOFS`]): the model gains *idle* dofs — unit mass on a unit
 //! spring to ground, coupled to nothing, starting at rest — that stay
 //! exactly zero (their force `−1·0` is zero in floating point), so the real
