@@ -392,6 +392,18 @@ impl Staging {
         Staging::new_as("--out", dest)
     }
 
+    /// Stage a command's output folder: `out` (its `--out`), or else
+    /// `out/<default_name>`, named "output folder (default --out)" in messages.
+    pub fn for_out(out: Option<&Path>, default_name: &str) -> Result<Staging, RunError> {
+        match out {
+            Some(dest) => Staging::new_as("--out", dest),
+            None => Staging::new_as(
+                "output folder (default --out)",
+                &Path::new("out").join(default_name),
+            ),
+        }
+    }
+
     /// [`Staging::new`] naming the flag that chose `dest` in messages.
     pub fn new_as(flag: &str, dest: &Path) -> Result<Staging, RunError> {
         check_dest_as(flag, dest)?;

@@ -287,19 +287,8 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
     let (sc, x, y) = prepare(&a)?;
     let n = x.values.len() * y.values.len();
     let shard = a.shard.as_deref().map(Shard::parse).transpose()?;
-    let dest = a.out.clone().unwrap_or_else(|| {
-        let base = format!("{}-map", sc.name);
-        PathBuf::from("out").join(match shard {
-            Some(s) => format!("{base}-shard-{}-of-{}", s.k, s.n),
-            None => base,
-        })
-    });
-    let flag = if a.out.is_some() {
-        "--out"
-    } else {
-        "output folder (default --out)"
-    };
-    let stage = Staging::new_as(flag, &dest)?;
+    let name = Shard::folder(&format!("{}-map", sc.name), shard);
+    let stage = Staging::for_out(a.out.as_deref(), &name)?;
     let points = match shard {
         Some(s) => s.points(n),
         None => all_points(&x, &y),

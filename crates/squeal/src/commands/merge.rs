@@ -61,6 +61,15 @@ pub struct Shard {
 }
 
 impl Shard {
+    /// The default output folder's name of a study called `base`: `base`, or
+    /// `base-shard-K-of-N` for a shard.
+    pub fn folder(base: &str, shard: Option<Shard>) -> String {
+        match shard {
+            Some(s) => format!("{base}-shard-{}-of-{}", s.k, s.n),
+            None => base.to_string(),
+        }
+    }
+
     /// Parse `K/N` (the `--shard` flag).
     pub fn parse(s: &str) -> Result<Shard, InputError> {
         let bad = |why: &str| InputError(format!("--shard {s}: {why}"));

@@ -903,18 +903,7 @@ pub fn run(a: ReproduceArgs) -> Result<(), RunError> {
     let shard = a.shard.as_deref().map(Shard::parse).transpose()?;
     let sets = prepared_sets(a.duration_scale)?;
     let start = Instant::now();
-    let dest = a.out.clone().unwrap_or_else(|| {
-        PathBuf::from("out").join(match shard {
-            Some(s) => format!("reproduce-shard-{}-of-{}", s.k, s.n),
-            None => "reproduce".into(),
-        })
-    });
-    let flag = if a.out.is_some() {
-        "--out"
-    } else {
-        "output folder (default --out)"
-    };
-    let stage = Staging::new_as(flag, &dest)?;
+    let stage = Staging::for_out(a.out.as_deref(), &Shard::folder("reproduce", shard))?;
     let figures = stage.dir().join("figures");
     let figures = (!a.no_figures).then_some(figures.as_path());
     if let Some(s) = shard {

@@ -123,16 +123,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
             }
         }
     }
-    let dest = a
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(&sc.name));
-    let flag = if a.out.is_some() {
-        "--out"
-    } else {
-        "output folder (default --out)"
-    };
-    let stage = Staging::new_as(flag, &dest)?;
+    let stage = Staging::for_out(a.out.as_deref(), &sc.name)?;
     let run = run::run(&sc)?;
     let t0 = Instant::now();
     if csv {

@@ -64,19 +64,8 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
             .into());
         }
     }
-    let dest = a.out.clone().unwrap_or_else(|| {
-        let base = format!("{}-sweep", sc.name);
-        PathBuf::from("out").join(match shard {
-            Some(s) => format!("{base}-shard-{}-of-{}", s.k, s.n),
-            None => base,
-        })
-    });
-    let flag = if a.out.is_some() {
-        "--out"
-    } else {
-        "output folder (default --out)"
-    };
-    let stage = Staging::new_as(flag, &dest)?;
+    let name = Shard::folder(&format!("{}-sweep", sc.name), shard);
+    let stage = Staging::for_out(a.out.as_deref(), &name)?;
     let unit = unit_of(&sc.model, &axis.name);
     let xl = if unit.is_empty() {
         axis.name.clone()
