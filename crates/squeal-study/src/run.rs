@@ -5,10 +5,12 @@ use crate::model::observe_all;
 use crate::model::AnyModel;
 use crate::scenario::{InputError, Scenario};
 use squeal_core::initial::initial_state;
+use squeal_core::integrate::ensemble::{simulate_ensemble_lanes, Job};
 use squeal_core::integrate::{Flow, Sink};
 use squeal_core::model::lumped::padding;
 use squeal_core::model::{Modes, Observables};
-use squeal_core::{simulate, EventKind, Mode, RunInfo, System};
+use squeal_core::{simulate, DiscPad, EventKind, IntegrateError, Mode, RunInfo, System};
+use std::borrow::Borrow;
 
 /// How many samples pass between two looks at the [`Cancel`] token.
 const CANCEL_EVERY: u32 = 1024;
@@ -56,6 +58,10 @@ impl Run {
 struct Collect<'a, M: ?Sized> {
     model: &'a M,
     any: &'a AnyModel,
+    /// Column names, see [`Run::columns`].
+    columns: Vec<String>,
+    /// See [`Run::contact_names`].
+    contact_names: Vec<String>,
     data: Vec<Vec<f64>>,
     /// The states written, in order (all `N`, or a padded model's real ones).
     states: Vec<usize>,
@@ -157,6 +163,73 @@ pub fn sim_options<const N: usize>(sc: &Scenario) -> squeal_core::SolverOptions 
     padding::padded_solver::<N>(&sc.solver, sc.offsets.len())
 }
 
+impl<'a, M: ?Sized> Collect<'a, M> {
+    /// An empty collector for a run of `sc` on `model` (`N` states, or a
+    /// padded model's real ones), with its column names.
+    fn new<const N: usize>(
+        model: &'a M,
+        any: &'a AnyModel,
+        sc: &Scenario,
+        progress: &'a dyn Progress,
+        cancel: &'a Cancel,
+    ) -> Self
+    where
+        M: System<N>,
+    {
+        // A padded model's idle dofs are not written: the run reads as the real model's.
+        let states: Vec<usize> = padding::real_states::<N>(sc.offsets.len() / 2).collect();
+        let names = model.names();
+        let mut columns = vec!["t".to_string()];
+        columns.extend(states.iter().map(|&i| names[i].clone()));
+        columns.extend(any.derived_columns());
+        let expected = (sc.duration * sc.sample_rate) as usize + 2;
+        Collect {
+            model,
+            any,
+            data: (0..columns.len())
+                .map(|_| Vec::with_capacity(expected))
+                .collect(),
+            columns,
+            contact_names: (0..model.contacts())
+                .map(|i| model.contact_name(i).to_string())
+                .collect(),
+            states,
+            derived: Vec::with_capacity(8),
+            obs: Vec::with_capacity(model.contacts()),
+            events: Vec::new(),
+            event_contacts: Vec::new(),
+            progress,
+            cancel,
+            until_check: CANCEL_EVERY,
+            t_end: sc.duration,
+            next_tick: 0.0,
+            ticks: 0,
+        }
+    }
+
+    /// The finished [`Run`] of `sc` from the integrator's result `info`: a
+    /// failure explained, [`StudyError::Interrupted`] if `cancel` was set.
+    fn into_run(
+        self,
+        info: Result<RunInfo, IntegrateError>,
+        sc: &Scenario,
+    ) -> Result<Run, StudyError> {
+        let info = info.map_err(|e| StudyError::Numerical(explain(e, sc.duration)))?;
+        self.progress.finish();
+        self.cancel.check()?;
+        Ok(Run {
+            columns: self.columns,
+            data: self.data,
+            events: self.events,
+            event_contacts: self.event_contacts,
+            contact_names: self.contact_names,
+            info,
+            integrate_s: 0.0,
+            sample_rate: sc.sample_rate,
+        })
+    }
+}
+
 fn run_model<M: System<N> + ?Sized, const N: usize>(
     model: &M,
     any: &AnyModel,
@@ -166,31 +239,7 @@ fn run_model<M: System<N> + ?Sized, const N: usize>(
 ) -> Result<Run, StudyError> {
     cancel.check()?;
     let z0 = initial_of(model, sc)?;
-    // A padded model's idle dofs are not written: the run reads as the real model's.
-    let states: Vec<usize> = padding::real_states::<N>(sc.offsets.len() / 2).collect();
-    let names = model.names();
-    let mut columns = vec!["t".to_string()];
-    columns.extend(states.iter().map(|&i| names[i].clone()));
-    columns.extend(any.derived_columns());
-    let expected = (sc.duration * sc.sample_rate) as usize + 2;
-    let mut sink = Collect {
-        model,
-        any,
-        data: (0..columns.len())
-            .map(|_| Vec::with_capacity(expected))
-            .collect(),
-        states,
-        derived: Vec::with_capacity(8),
-        obs: Vec::with_capacity(model.contacts()),
-        events: Vec::new(),
-        event_contacts: Vec::new(),
-        progress,
-        cancel,
-        until_check: CANCEL_EVERY,
-        t_end: sc.duration,
-        next_tick: 0.0,
-        ticks: 0,
-    };
+    let mut sink = Collect::new::<N>(model, any, sc, progress, cancel);
     let info = simulate(
         model,
         0.0,
@@ -199,22 +248,8 @@ fn run_model<M: System<N> + ?Sized, const N: usize>(
         sc.sample_rate,
         sim_options::<N>(sc),
         &mut sink,
-    )
-    .map_err(|e| StudyError::Numerical(explain(e, sc.duration)))?;
-    progress.finish();
-    cancel.check()?;
-    Ok(Run {
-        columns,
-        data: sink.data,
-        events: sink.events,
-        event_contacts: sink.event_contacts,
-        contact_names: (0..model.contacts())
-            .map(|i| model.contact_name(i).to_string())
-            .collect(),
-        info,
-        integrate_s: 0.0,
-        sample_rate: sc.sample_rate,
-    })
+    );
+    sink.into_run(info, sc)
 }
 
 /// An integration failure in words; an exhausted step budget says why the
@@ -237,4 +272,87 @@ pub fn explain(e: squeal_core::IntegrateError, duration: f64) -> String {
 pub fn run(sc: &Scenario, progress: &dyn Progress, cancel: &Cancel) -> Result<Run, StudyError> {
     crate::with_sim_system!(&sc.model, m => run_model(m, &sc.model, sc, progress, cancel),
         else => Err(StudyError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))))
+}
+
+/// A [`Progress`] passing on every `inc` but not `finish` (the runs of
+/// [`run_many`] share one bar, finished once when all are done).
+struct Unfinished<'a>(&'a dyn Progress);
+
+impl Progress for Unfinished<'_> {
+    fn inc(&self, n: u64) {
+        self.0.inc(n);
+    }
+}
+
+/// Integrate several scenarios on the calling thread: the results of
+/// [`run`] on each, in order, **bit for bit** (columns, data, events,
+/// event contacts, [`RunInfo`], and every error with its
+/// [`explain`]ed text), however they are grouped.
+///
+/// The disc–pad scenarios run as ensembles
+/// ([`simulate_ensemble_lanes`], [`LANES`](squeal_core::integrate::ensemble::LANES)
+/// of them stepped together, one ensemble per sample rate): a lane whose
+/// run ends (finished, failed, or stopped by `cancel`) takes the next
+/// scenario while the others go on, and the ensemble's runs are the same
+/// bits as single runs (`squeal_core::integrate::ensemble`). Every other
+/// model runs through [`run`] one after the other. `progress` counts
+/// thousandths of each run's duration (1000 per scenario) and is finished
+/// once, at the end; a scenario begun after `cancel` is set, or whose run
+/// saw it, is [`StudyError::Interrupted`].
+pub fn run_many<S: Borrow<Scenario>>(
+    scs: &[S],
+    progress: &dyn Progress,
+    cancel: &Cancel,
+) -> Vec<Result<Run, StudyError>> {
+    let quiet = Unfinished(progress);
+    let mut out: Vec<Option<Result<Run, StudyError>>> = (0..scs.len()).map(|_| None).collect();
+    // An ensemble feeds one sample rate: the disc–pads are grouped by theirs.
+    let mut rates: Vec<u64> = Vec::new();
+    for (slot, sc) in out.iter_mut().zip(scs) {
+        let sc = sc.borrow();
+        match &sc.model {
+            AnyModel::DiscPad(_) => {
+                if !rates.contains(&sc.sample_rate.to_bits()) {
+                    rates.push(sc.sample_rate.to_bits());
+                }
+            }
+            _ => *slot = Some(run(sc, &quiet, cancel)),
+        }
+    }
+    for rate in rates {
+        let mut jobs: Vec<Job<'_, DiscPad, Collect<'_, DiscPad>, 8>> = Vec::new();
+        let mut slots = Vec::new();
+        for (k, sc) in scs.iter().enumerate() {
+            let sc = sc.borrow();
+            let AnyModel::DiscPad(m) = &sc.model else {
+                continue;
+            };
+            if sc.sample_rate.to_bits() != rate {
+                continue;
+            }
+            // What `run_model` does before it integrates.
+            match cancel.check().and_then(|_| initial_of(m, sc)) {
+                Ok(z0) => {
+                    jobs.push(Job {
+                        model: m,
+                        t0: 0.0,
+                        z0,
+                        t_end: sc.duration,
+                        opts: sim_options::<8>(sc),
+                        sink: Collect::new::<8>(m, &sc.model, sc, &quiet, cancel),
+                    });
+                    slots.push(k);
+                }
+                Err(e) => out[k] = Some(Err(e)),
+            }
+        }
+        let infos = simulate_ensemble_lanes(&mut jobs, f64::from_bits(rate));
+        for ((job, info), k) in jobs.into_iter().zip(infos).zip(slots) {
+            out[k] = Some(job.sink.into_run(info, scs[k].borrow()));
+        }
+    }
+    progress.finish();
+    out.into_iter()
+        .map(|r| r.expect("every scenario ran"))
+        .collect()
 }
