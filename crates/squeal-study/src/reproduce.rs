@@ -183,17 +183,30 @@ pub fn squeal_answer(an: &Analysis) -> Option<SquealAnswer> {
 /// Measure one set: its eigenvalues, a run and its analysis, and the
 /// numbers the conclusions need. `after` sees the run and its analysis
 /// before they are dropped (the CLI draws Appendix A's pictures there).
+/// [`measure_run`] of [`run::run`](crate::run::run)'s run of `sc`.
 pub fn measure<E: From<StudyError>>(
     id: usize,
     sc: Scenario,
     cancel: &Cancel,
     after: impl Fn(&Run, &Analysis) -> Result<(), E>,
 ) -> Result<SetResult, E> {
+    let run: Run = crate::run::run(&sc, &NoProgress, cancel)?;
+    measure_run(id, sc, run, after)
+}
+
+/// [`measure`] with the set's run already done (e.g. by
+/// [`run_many`](crate::run::run_many) with other sets): its eigenvalues,
+/// the run's analysis, and the numbers the conclusions need.
+pub fn measure_run<E: From<StudyError>>(
+    id: usize,
+    sc: Scenario,
+    run: Run,
+    after: impl Fn(&Run, &Analysis) -> Result<(), E>,
+) -> Result<SetResult, E> {
     let (linear, linear_note) = match linear_of(&sc.model) {
         Ok(l) => (Some(l), String::new()),
         Err(e) => (None, e),
     };
-    let run: Run = crate::run::run(&sc, &NoProgress, cancel)?;
     let ch = sc.model.channels();
     let an: Analysis = analysis::analyse(
         &run,

@@ -8,7 +8,6 @@
 use crate::error::{Cancel, NoProgress, StudyError};
 use crate::run::{self, Run};
 use crate::scenario::{Scenario, Setting};
-use rayon::prelude::*;
 use squeal_core::model::disc_pad::DiscPad;
 use squeal_core::stability::track::Complex;
 use squeal_core::stability::track::{self, rel_distance};
@@ -297,7 +296,8 @@ fn tangential(m: &DiscPad) -> Option<(f64, f64, f64)> {
 }
 
 /// Sweep c_px across the pad's Hopf damping: eigenvalues and runs from
-/// steady sliding with the pad and the disc kicked.
+/// steady sliding with the pad and the disc kicked. The runs go together
+/// on the calling thread ([`run::run_many`]), the same bits as one by one.
 pub fn cpx_sweep(
     base: &Scenario,
     factors: &[f64],
@@ -321,26 +321,36 @@ pub fn cpx_sweep(
         .filter_map(|mm| tangential(&mm))
         .map(|t| ((t.0 - disc0) / disc0).abs())
         .fold(0.0, f64::max);
-    let points: Result<Vec<CpxPoint>, StudyError> = factors
-        .par_iter()
+    // The runs go together on this thread (run_many: one ensemble of
+    // disc–pads, bit for bit their single runs).
+    let scs: Vec<Scenario> = factors
+        .iter()
         .map(|&k| {
-            let c_px = k * c_star;
-            let sc = scenario_with(
+            scenario_with(
                 base,
                 &[
-                    ("c_px", Setting::Number(c_px)),
+                    ("c_px", Setting::Number(k * c_star)),
                     ("initial", Setting::Text("equilibrium".into())),
                     ("vx_p0", Setting::Number(kick.0)),
                     ("vx_d0", Setting::Number(kick.1)),
                     ("duration", Setting::Number(duration)),
                 ],
-            )?;
+            )
+        })
+        .collect::<Result<_, _>>()?;
+    let runs = run::run_many(&scs, &NoProgress, cancel);
+    let points: Result<Vec<CpxPoint>, StudyError> = factors
+        .iter()
+        .zip(&scs)
+        .zip(runs)
+        .map(|((&k, sc), r)| {
+            let c_px = k * c_star;
             let crate::model::AnyModel::DiscPad(mm) = sc.model else {
                 unreachable!("the base is a disc–pad")
             };
             let (sigma_disc, sigma_pad, f_disc) =
                 tangential(&mm).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
-            let r: Run = run::run(&sc, &NoProgress, cancel)?;
+            let r: Run = r?;
             let saturated_at = r
                 .events
                 .iter()
