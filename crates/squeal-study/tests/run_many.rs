@@ -1,7 +1,7 @@
 //! `run::run_many` (the disc–pads as ensembles, issue 16 point 2) gives
 //! every scenario's `run::run` result bit for bit: columns, events, solver
 //! statistics and error texts, with lanes that end early, refill, fail or
-//! stick while the others go on.
+//! stick while the others go on, and runs refused before they start.
 
 use squeal_core::EventKind;
 use squeal_study::run::{run, run_many, Run};
@@ -76,6 +76,10 @@ fn run_many_is_run_on_each_scenario_bit_for_bit() {
     let mut budget = scenario("disc-pad", &["duration=0.05", "V=3"]);
     // A budget far too small: this run fails early while the others go on.
     budget.solver.max_steps = 300;
+    // No steady sliding to start from: refused before it is integrated.
+    let mut unstartable = scenario("disc-pad", &["duration=0.01"]);
+    unstartable.model.set("V", 0.0).unwrap();
+    unstartable.initial = squeal_core::initial::Initial::Equilibrium;
     let scs = vec![
         // The default run (it squeals from rest), long.
         scenario("disc-pad", &["duration=0.12"]),
@@ -92,6 +96,7 @@ fn run_many_is_run_on_each_scenario_bit_for_bit() {
         scenario("disc-pad", &["V=20", "N=800", "duration=0.015"]),
         scenario("two-pad-brake", &["duration=0.02"]),
         scenario("disc-pad", &["V=4", "N=1000", "duration=0.04"]),
+        unstartable,
     ];
     let cancel = Cancel::new();
     let one: Vec<_> = scs.iter().map(|s| run(s, &NoProgress, &cancel)).collect();
@@ -109,12 +114,14 @@ fn run_many_is_run_on_each_scenario_bit_for_bit() {
         stick.events.iter().any(|e| e.1 == EventKind::Stick),
         "scenario 1 sticks"
     );
-    assert!(one.iter().filter(|r| r.is_ok()).count() == scs.len() - 1);
+    let err = one[10].as_ref().unwrap_err().to_string();
+    assert!(err.contains("initial = equilibrium"), "{err}");
+    assert!(one.iter().filter(|r| r.is_ok()).count() == scs.len() - 2);
     // One bar for all: finished once, about 1000 thousandths per finished run.
     assert_eq!(count.1.load(Ordering::Relaxed), 1);
     let ticks = count.0.load(Ordering::Relaxed);
     assert!(
-        ticks <= 1000 * scs.len() as u64 && ticks >= 900 * (scs.len() - 1) as u64,
+        ticks <= 1000 * scs.len() as u64 && ticks >= 900 * (scs.len() - 2) as u64,
         "{ticks}"
     );
     // The scenarios by reference, and in another order, give the same runs.
@@ -127,6 +134,10 @@ fn run_many_is_run_on_each_scenario_bit_for_bit() {
 
 #[test]
 fn run_many_after_cancel_interrupts_every_scenario() {
+    // No steady sliding to start from: refused before it is integrated.
+    let mut unstartable = scenario("disc-pad", &["duration=0.01"]);
+    unstartable.model.set("V", 0.0).unwrap();
+    unstartable.initial = squeal_core::initial::Initial::Equilibrium;
     let scs = vec![
         scenario("disc-pad", &["duration=0.01"]),
         scenario("belt", &["duration=0.5"]),
