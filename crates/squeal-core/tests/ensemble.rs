@@ -169,7 +169,8 @@ fn disc_pad_lanes_match_single_runs() {
 
     let single = same_as_single::<DiscPad, 8>(&models, &cases, 50_000.0, simulate_ensemble);
     // The same with the lane-wise right-hand side (the Stribeck lane makes
-    // its lane set fall back to `field`; lanes in stick fall back alone).
+    // its lane set fall back to `field`; without it, lanes in slip, stick
+    // and free flight are computed lane-wise together).
     same_as_single::<DiscPad, 8>(&models, &cases, 50_000.0, simulate_ensemble_lanes);
     let thesis: Vec<usize> = (0..models.len()).filter(|&k| k != 2).collect();
     same_as_single::<DiscPad, 8>(
@@ -238,9 +239,10 @@ fn belt_lanes_match_single_runs() {
 }
 
 /// The disc–pad's lane-wise right-hand side equals `field` lane by lane, bit
-/// for bit, in both slip directions, for four different models (speeds,
-/// loads, follower force, a ramp in progress and one finished); it leaves
-/// stick and free flight to `field`, and other friction laws altogether.
+/// for bit, in every mode (both slip directions, stick, free flight, mixed
+/// across the lanes), for four different models (speeds, loads, follower
+/// force, a ramp in progress and one finished); it leaves other friction
+/// laws to `field` altogether.
 #[test]
 fn disc_pad_lane_field_is_field_bit_for_bit() {
     let mut models = [DiscPad::default(); LANES];
@@ -260,16 +262,21 @@ fn disc_pad_lane_field_is_field_bit_for_bit() {
     };
     let scale = [1e-6, 1e-6, 1e-6, 1e-6, 2.0, 2.0, 1.0, 1.0];
     for case in 0..2000 {
+        // Displacements from 1 µm to 1 cm, so that the follower force
+        // α·F_t·y_d (which carries the stick force) shows in the slopes.
+        let grow = [10f64.powi((case % 5) as i32), 1.0];
         let z: [[f64; 8]; LANES] =
-            std::array::from_fn(|_| std::array::from_fn(|i| scale[i] * rnd()));
+            std::array::from_fn(|_| std::array::from_fn(|i| scale[i] * grow[i / 4] * rnd()));
         let t: [f64; LANES] = std::array::from_fn(|_| 0.01 * rnd().abs());
-        let modes: [Mode; LANES] = std::array::from_fn(|l| {
-            if (case + l) % 3 == 0 {
-                Mode::SlipNeg
-            } else {
-                Mode::SlipPos
-            }
-        });
+        // Every mix of modes across the lanes comes up (4⁴ = 256 patterns
+        // over the cases); slip is the most common, as in a run.
+        let modes: [Mode; LANES] =
+            std::array::from_fn(|l| match (case / 4usize.pow(l as u32)) % 4 {
+                0 => Mode::SlipNeg,
+                1 => Mode::Stick,
+                2 => Mode::Free,
+                _ => Mode::SlipPos,
+            });
         let zl: [f64x4; 8] = std::array::from_fn(|i| f64x4::new(std::array::from_fn(|l| z[l][i])));
         let mut dz = [f64x4::ZERO; 8];
         let lane_modes = modes.map(|m| Some(Modes::single(m)));
@@ -289,8 +296,7 @@ fn disc_pad_lane_field_is_field_bit_for_bit() {
             }
         }
     }
-    // Idle lanes are not computed; lanes in stick or free flight are left
-    // to `field`, the others are computed.
+    // Idle lanes are not computed; lanes in any mode are.
     let zl = [f64x4::ZERO; 8];
     let mut dz = [f64x4::ZERO; 8];
     let mut lane_modes = [None; LANES];
@@ -300,9 +306,11 @@ fn disc_pad_lane_field_is_field_bit_for_bit() {
     lane_modes[1] = Some(Modes::single(Mode::Stick));
     lane_modes[2] = Some(Modes::single(Mode::Free));
     let done = DiscPad::field_lanes(&pack, f64x4::ZERO, &lane_modes, &zl, &mut dz);
-    assert_eq!(done, [true, false, false, false]);
+    assert_eq!(done, [true, true, true, false]);
     lane_modes[0] = None;
     let done = DiscPad::field_lanes(&pack, f64x4::ZERO, &lane_modes, &zl, &mut dz);
+    assert_eq!(done, [false, true, true, false]);
+    let done = DiscPad::field_lanes(&pack, f64x4::ZERO, &[None; LANES], &zl, &mut dz);
     assert_eq!(done, [false; LANES]);
     let mut strib = models;
     strib[3].friction = FrictionLaw::by_name("stribeck").unwrap();

@@ -14,10 +14,13 @@
 //! combination serves four lanes per instruction. With each lane's
 //! right-hand side called on its own ([`simulate_ensemble`]) that is eaten
 //! by copying states and slopes in and out of the lanes; with a model's
-//! lane-wise [`LaneField`] ([`simulate_ensemble_lanes`]) the disc–pad runs
-//! 1.25–1.45× as many steps per CPU-second as one at a time on the default
-//! x86-64-v3 build (BENCHMARKS.md, issue 16). Transient maps of the
-//! disc–pad use it.
+//! lane-wise [`LaneField`] ([`simulate_ensemble_lanes`]), the lanes' modes
+//! turned into masks once per attempt and the error norms computed
+//! lane-wise too, the disc–pad runs 1.5–1.7× as many steps per CPU-second
+//! as one at a time on the default x86-64-v3 build, in 29 % fewer
+//! instructions (BENCHMARKS.md, issue 16). Transient maps of the disc–pad
+//! use it. What stays per lane: the step-size control (two `powf`), the
+//! event search on the dense output, transitions and the sink.
 //!
 //! A lane whose run ends (finished, stopped by its sink, or failed) takes
 //! the next job at once, so a sweep of many short runs keeps all lanes busy.
@@ -25,7 +28,7 @@
 use super::tableau::{A, B, C, D, E3, E5};
 use super::{check_rate, Feed, IntegrateError, RunInfo, Sink, Solver, SolverOptions};
 use crate::model::{Modes, System};
-use wide::f64x4;
+use wide::{f64x4, CmpEq};
 
 /// Lanes of an ensemble: one [`f64x4`] holds a number of each.
 pub const LANES: usize = 4;
@@ -62,10 +65,26 @@ pub trait LaneField<const N: usize>: System<N> + Sized {
     /// What the lane-wise field needs of the lanes' models, gathered once
     /// per change of the lanes' jobs (not on every call).
     type Pack;
+    /// What the lane-wise field needs of the lanes' modes, made once per
+    /// attempt (the modes hold over a step's stages).
+    type Masks;
     /// The pack of the lanes' models (`None`: an empty lane); `None` if these
     /// models cannot be evaluated lane-wise (every call then falls back to
     /// [`System::field`]).
     fn pack(models: [Option<&Self>; LANES]) -> Option<Self::Pack>;
+    /// The masks of the lanes' `modes` (`None`: an idle lane), and the
+    /// lanes that [`field_masked`](Self::field_masked) computes with them;
+    /// the others are left to [`System::field`].
+    fn masks(modes: &[Option<Modes>; LANES]) -> (Self::Masks, [bool; LANES]);
+    /// `dz = f(t, z)` lane by lane, each lane in the modes of `masks`. The
+    /// `dz` of lanes it does not compute may hold anything.
+    fn field_masked(
+        pack: &Self::Pack,
+        masks: &Self::Masks,
+        t: f64x4,
+        z: &[f64x4; N],
+        dz: &mut [f64x4; N],
+    );
     /// `dz = f(t, z)` lane by lane, each lane in its own `modes`
     /// (`None`: an idle lane, whose `dz` is not used). Returns the lanes it
     /// computed; the others' `dz` may hold anything (they are computed
@@ -76,64 +95,81 @@ pub trait LaneField<const N: usize>: System<N> + Sized {
         modes: &[Option<Modes>; LANES],
         z: &[f64x4; N],
         dz: &mut [f64x4; N],
-    ) -> [bool; LANES];
+    ) -> [bool; LANES] {
+        let (masks, done) = Self::masks(modes);
+        if done.contains(&true) {
+            Self::field_masked(pack, &masks, t, z, dz);
+        }
+        done
+    }
 }
 
 /// How the lanes' slopes are computed: one model call per lane
 /// ([`PerLane`]), or a [`LaneField`] for all lanes at once ([`Packed`]).
 trait Slopes<M: System<N> + ?Sized, const N: usize> {
+    /// What [`lanes`](Self::lanes) needs of the lanes' modes.
+    type Masks;
     /// The lanes' jobs changed: gather what the lane-wise field needs.
     fn repack(&mut self, lanes: &[Option<Lane<'_, M, N>>; L]);
-    /// The slopes at `(t, z)` of the lanes with `modes` in `dz`; returns
-    /// the lanes computed (the others are left to [`System::field`]).
-    fn lanes(
-        &self,
-        t: f64x4,
-        modes: &[Option<Modes>; L],
-        z: &[f64x4; N],
-        dz: &mut [f64x4; N],
-    ) -> [bool; L];
+    /// The masks of the lanes' `modes`, and the lanes that
+    /// [`lanes`](Self::lanes) computes (the others are left to
+    /// [`System::field`]).
+    fn masks(&self, modes: &[Option<Modes>; L]) -> (Self::Masks, [bool; L]);
+    /// The slopes at `(t, z)` of the lanes it computes, in `dz`.
+    fn lanes(&self, masks: &Self::Masks, t: f64x4, z: &[f64x4; N], dz: &mut [f64x4; N]);
 }
 
 /// Every lane's slope by its own model call.
 struct PerLane;
 
 impl<M: System<N> + ?Sized, const N: usize> Slopes<M, N> for PerLane {
+    type Masks = ();
     fn repack(&mut self, _lanes: &[Option<Lane<'_, M, N>>; L]) {}
-    #[inline(always)]
-    fn lanes(
-        &self,
-        _t: f64x4,
-        _modes: &[Option<Modes>; L],
-        _z: &[f64x4; N],
-        _dz: &mut [f64x4; N],
-    ) -> [bool; L] {
-        [false; L]
+    fn masks(&self, _modes: &[Option<Modes>; L]) -> ((), [bool; L]) {
+        ((), [false; L])
     }
+    #[inline(always)]
+    fn lanes(&self, _masks: &(), _t: f64x4, _z: &[f64x4; N], _dz: &mut [f64x4; N]) {}
 }
 
 /// The lanes' slopes by the model's [`LaneField`].
 struct Packed<M: LaneField<N>, const N: usize>(Option<M::Pack>);
 
 impl<M: LaneField<N>, const N: usize> Slopes<M, N> for Packed<M, N> {
+    type Masks = Option<M::Masks>;
     fn repack(&mut self, lanes: &[Option<Lane<'_, M, N>>; L]) {
         self.0 = M::pack(std::array::from_fn(|l| {
             lanes[l].as_ref().map(|lane| lane.solver.model)
         }));
     }
-    #[inline(always)]
-    fn lanes(
-        &self,
-        t: f64x4,
-        modes: &[Option<Modes>; L],
-        z: &[f64x4; N],
-        dz: &mut [f64x4; N],
-    ) -> [bool; L] {
+    fn masks(&self, modes: &[Option<Modes>; L]) -> (Option<M::Masks>, [bool; L]) {
         match &self.0 {
-            Some(pack) => M::field_lanes(pack, t, modes, z, dz),
-            None => [false; L],
+            Some(_) => {
+                let (masks, done) = M::masks(modes);
+                (Some(masks), done)
+            }
+            None => (None, [false; L]),
         }
     }
+    #[inline(always)]
+    fn lanes(&self, masks: &Option<M::Masks>, t: f64x4, z: &[f64x4; N], dz: &mut [f64x4; N]) {
+        if let (Some(pack), Some(masks)) = (&self.0, masks) {
+            M::field_masked(pack, masks, t, z, dz);
+        }
+    }
+}
+
+/// The lanes of an attempt (or of the dense output's stages) and their
+/// modes, as every stage's slopes need them: made once, used by each stage.
+struct Batch<Mk> {
+    /// The modes of the lanes taking part (`None`: left out).
+    modes: [Option<Modes>; L],
+    /// The lane-wise field's masks of these modes.
+    masks: Mk,
+    /// Lanes taking part that the lane-wise field does not compute.
+    rest: [bool; L],
+    /// Whether the lane-wise field computes any lane.
+    any: bool,
 }
 
 /// A lane at work: its job's index, solver, feed, and the step in progress.
@@ -239,6 +275,7 @@ where
         let jobs_now = std::array::from_fn(|l| lanes[l].as_ref().map(|lane| lane.job));
         if jobs_now != packed_jobs {
             slopes.repack(&lanes);
+            soa.tolerances(&lanes);
             packed_jobs = jobs_now;
         }
         // One attempt of every active lane, together.
@@ -250,7 +287,7 @@ where
             }
             let lane = lanes[l].as_mut().expect("active");
             let (h, hits_stop) = lane.attempt;
-            let (z_new, err) = soa.outcome(l, &lane.solver);
+            let (z_new, err) = soa.outcome(l);
             match lane.solver.judge(h, hits_stop, &z_new, err) {
                 Ok(ok) => accepted[l] = ok,
                 Err(e) => {
@@ -355,6 +392,13 @@ struct Soa<const N: usize> {
     e3: [f64x4; N],
     t: [f64; L],
     h: f64x4,
+    /// The lanes' tolerances and norm sizes (as their solvers hold them),
+    /// gathered once per change of the lanes' jobs.
+    atol: [f64x4; N],
+    rtol: f64x4,
+    norm_n: f64x4,
+    /// The lanes' error norms of the last attempt.
+    err: [f64; L],
 }
 
 /// Lane `l` of every state.
@@ -373,81 +417,113 @@ impl<const N: usize> Soa<N> {
             e3: [f64x4::ZERO; N],
             t: [0.0; L],
             h: f64x4::ZERO,
+            atol: [f64x4::ONE; N],
+            rtol: f64x4::ONE,
+            norm_n: f64x4::ONE,
+            err: [0.0; L],
         }
     }
 
-    /// Stage `S` of every lane in `mask`: its state from the earlier
-    /// stages (all lanes at once), its slope from the lane's own model.
+    /// Gather the lanes' tolerances (idle lanes: ones, never used).
+    fn tolerances<M: System<N> + ?Sized>(&mut self, lanes: &[Option<Lane<'_, M, N>>; L]) {
+        let of = |f: &dyn Fn(&Solver<'_, M, N>) -> f64| {
+            f64x4::new(std::array::from_fn(|l| {
+                lanes[l].as_ref().map_or(1.0, |lane| f(&lane.solver))
+            }))
+        };
+        self.atol = std::array::from_fn(|i| of(&|s| s.atol[i]));
+        self.rtol = of(&|s| s.opts.rtol);
+        self.norm_n = of(&|s| s.norm_n);
+    }
+
+    /// Stage `S` of the lanes of `batch`: its state from the earlier stages
+    /// (all lanes at once), its slope.
     #[inline(always)]
     fn stage<M: System<N> + ?Sized, F: Slopes<M, N>, const S: usize>(
         &mut self,
-        lanes: &mut [Option<Lane<'_, M, N>>; L],
-        mask: &[bool; L],
+        lanes: &[Option<Lane<'_, M, N>>; L],
+        batch: &Batch<F::Masks>,
         f: &F,
     ) {
         let y = combine_lanes::<N, S>(&self.k, &self.z, &A[S], self.h);
-        self.slopes(lanes, mask, S, &y, C[S], f);
+        self.slopes(lanes, batch, S, &y, C[S], f);
     }
 
-    /// `k[s] = f(t + c·h, y)` of every lane in `mask` (0 elsewhere). Not
-    /// inlined: one copy of the right-hand side serves every stage, so the
-    /// code stays within the instruction cache.
+    /// `k[s] = f(t + c·h, y)` of the lanes of `batch` (anything
+    /// elsewhere): lane-wise by `f` where it can, by the lane's own model
+    /// where it declines. Not inlined: one copy of the right-hand side
+    /// serves every stage, so the code stays within the instruction cache.
     #[inline(never)]
     fn slopes<M: System<N> + ?Sized, F: Slopes<M, N>>(
         &mut self,
-        lanes: &mut [Option<Lane<'_, M, N>>; L],
-        mask: &[bool; L],
+        lanes: &[Option<Lane<'_, M, N>>; L],
+        batch: &Batch<F::Masks>,
         s: usize,
         y: &[f64x4; N],
         c: f64,
         f: &F,
     ) {
-        // The lanes' times, lane-wise: the same sums as below.
-        let t = f64x4::new(self.t);
-        let tc = if s == 12 {
-            t + self.h
-        } else {
-            t + f64x4::splat(c) * self.h
-        };
-        let modes: [Option<Modes>; L] = std::array::from_fn(|l| match (&lanes[l], mask[l]) {
-            (Some(lane), true) => Some(lane.solver.modes),
-            _ => None,
-        });
-        let done = f.lanes(tc, &modes, y, &mut self.k[s]);
+        if batch.any {
+            // The lanes' times, lane-wise: the same sums as below.
+            let t = f64x4::new(self.t);
+            let tc = if s == 12 {
+                t + self.h
+            } else {
+                t + f64x4::splat(c) * self.h
+            };
+            f.lanes(&batch.masks, tc, y, &mut self.k[s]);
+        }
+        let (modes, rest) = (&batch.modes, batch.rest);
+        if !rest.contains(&true) {
+            return;
+        }
         let h = self.h.to_array();
         let mut out = [[0.0; N]; L];
-        let mut rest = [false; L];
-        for (l, lane) in lanes.iter_mut().enumerate() {
-            if let (Some(lane), true) = (lane, mask[l]) {
-                let solver = &mut lane.solver;
-                solver.stats.rhs_evals += 1;
-                if done[l] {
-                    continue;
-                }
-                rest[l] = true;
+        for l in 0..L {
+            if let (Some(lane), Some(m), true) = (&lanes[l], &modes[l], rest[l]) {
                 let tc = if s == 12 {
                     self.t[l] + h[l]
                 } else {
                     self.t[l] + c * h[l]
                 };
-                solver
-                    .model
-                    .field(tc, &solver.modes, &lane_of(y, l), &mut out[l]);
+                lane.solver.model.field(tc, m, &lane_of(y, l), &mut out[l]);
             }
         }
         // The lanes evaluated one by one go in with one vector per state
         // (not lane by lane: a vector rebuilt from four scalar stores).
-        if rest.contains(&true) {
-            for i in 0..N {
-                let done_i = self.k[s][i].to_array();
-                self.k[s][i] = f64x4::new(std::array::from_fn(|l| {
-                    if rest[l] {
-                        out[l][i]
-                    } else {
-                        done_i[l]
-                    }
-                }));
+        for i in 0..N {
+            let done_i = self.k[s][i].to_array();
+            self.k[s][i] = f64x4::new(std::array::from_fn(|l| {
+                if rest[l] {
+                    out[l][i]
+                } else {
+                    done_i[l]
+                }
+            }));
+        }
+    }
+
+    /// The batch of the lanes in `mask`, each lane's right-hand-side count
+    /// raised by `evals` (the slopes about to be computed for it).
+    fn batch<M: System<N> + ?Sized, F: Slopes<M, N>>(
+        lanes: &mut [Option<Lane<'_, M, N>>; L],
+        mask: &[bool; L],
+        evals: u64,
+        f: &F,
+    ) -> Batch<F::Masks> {
+        let modes = std::array::from_fn(|l| match (&mut lanes[l], mask[l]) {
+            (Some(lane), true) => {
+                lane.solver.stats.rhs_evals += evals;
+                Some(lane.solver.modes)
             }
+            _ => None,
+        });
+        let (masks, done) = f.masks(&modes);
+        Batch {
+            modes,
+            masks,
+            rest: std::array::from_fn(|l| modes[l].is_some() && !done[l]),
+            any: done.contains(&true),
         }
     }
 
@@ -475,42 +551,49 @@ impl<const N: usize> Soa<N> {
             self.z[i] = f64x4::new(std::array::from_fn(|l| z[l][i]));
             self.k[0][i] = f64x4::new(std::array::from_fn(|l| f[l][i]));
         }
-        self.stage::<M, F, 1>(lanes, active, fields);
-        self.stage::<M, F, 2>(lanes, active, fields);
-        self.stage::<M, F, 3>(lanes, active, fields);
-        self.stage::<M, F, 4>(lanes, active, fields);
-        self.stage::<M, F, 5>(lanes, active, fields);
-        self.stage::<M, F, 6>(lanes, active, fields);
-        self.stage::<M, F, 7>(lanes, active, fields);
-        self.stage::<M, F, 8>(lanes, active, fields);
-        self.stage::<M, F, 9>(lanes, active, fields);
-        self.stage::<M, F, 10>(lanes, active, fields);
-        self.stage::<M, F, 11>(lanes, active, fields);
+        // Stages 1…11 and the slope at the new state: 12 evaluations.
+        let batch = Self::batch(lanes, active, 12, fields);
+        self.stage::<M, F, 1>(lanes, &batch, fields);
+        self.stage::<M, F, 2>(lanes, &batch, fields);
+        self.stage::<M, F, 3>(lanes, &batch, fields);
+        self.stage::<M, F, 4>(lanes, &batch, fields);
+        self.stage::<M, F, 5>(lanes, &batch, fields);
+        self.stage::<M, F, 6>(lanes, &batch, fields);
+        self.stage::<M, F, 7>(lanes, &batch, fields);
+        self.stage::<M, F, 8>(lanes, &batch, fields);
+        self.stage::<M, F, 9>(lanes, &batch, fields);
+        self.stage::<M, F, 10>(lanes, &batch, fields);
+        self.stage::<M, F, 11>(lanes, &batch, fields);
         let z_new = combine_lanes::<N, 12>(&self.k, &self.z, &B, self.h);
-        self.slopes(lanes, active, 12, &z_new, 1.0, fields);
+        self.slopes(lanes, &batch, 12, &z_new, 1.0, fields);
         self.z_new = z_new;
         let zero = [f64x4::ZERO; N];
         let one = f64x4::splat(1.0);
         self.e5 = combine_lanes::<N, 13>(&self.k, &zero, &E5, one);
         self.e3 = combine_lanes::<N, 13>(&self.k, &zero, &E3, one);
+        self.err = self.error_norms();
+    }
+
+    /// [`Solver::error_norm`] of every lane at once: the same operations in
+    /// the same order, lane-wise (`max` chooses the other lane of a NaN,
+    /// as `f64::max` does; `x·x` is `powi(2)`).
+    fn error_norms(&self) -> [f64; L] {
+        let (mut err5, mut err3) = (f64x4::ZERO, f64x4::ZERO);
+        for i in 0..N {
+            let sk = self.atol[i] + self.rtol * self.z[i].abs().max(self.z_new[i].abs());
+            let (a, b) = (self.e5[i] / sk, self.e3[i] / sk);
+            err5 += a * a;
+            err3 += b * b;
+        }
+        let norm = self.h.abs() * err5 / ((err5 + f64x4::splat(0.01) * err3) * self.norm_n).sqrt();
+        let zero = f64x4::ZERO;
+        let both_zero = err5.cmp_eq(zero) & err3.cmp_eq(zero);
+        both_zero.blend(zero, norm).to_array()
     }
 
     /// Lane `l`'s new state and error norm.
-    fn outcome<M: System<N> + ?Sized>(
-        &self,
-        l: usize,
-        solver: &Solver<'_, M, N>,
-    ) -> ([f64; N], f64) {
-        let z_new = lane_of(&self.z_new, l);
-        let h = self.h.as_array_ref()[l];
-        let err = solver.error_norm(
-            h,
-            &lane_of(&self.z, l),
-            &z_new,
-            &lane_of(&self.e5, l),
-            &lane_of(&self.e3, l),
-        );
-        (z_new, err)
+    fn outcome(&self, l: usize) -> ([f64; N], f64) {
+        (lane_of(&self.z_new, l), self.err[l])
     }
 
     /// Lane `l`'s new state.
@@ -527,9 +610,10 @@ impl<const N: usize> Soa<N> {
         accepted: &[bool; L],
         f: &F,
     ) {
-        self.stage::<M, F, 13>(lanes, accepted, f);
-        self.stage::<M, F, 14>(lanes, accepted, f);
-        self.stage::<M, F, 15>(lanes, accepted, f);
+        let batch = Self::batch(lanes, accepted, 3, f);
+        self.stage::<M, F, 13>(lanes, &batch, f);
+        self.stage::<M, F, 14>(lanes, &batch, f);
+        self.stage::<M, F, 15>(lanes, &batch, f);
         let zero = [f64x4::ZERO; N];
         let d: [[f64x4; N]; 4] = [
             combine_lanes::<N, 16>(&self.k, &zero, &D[0], self.h),

@@ -559,6 +559,7 @@ pub struct DiscPadLanes {
     neg_k_dy: f64x4,
     c_dy: f64x4,
     neg_k_px: f64x4,
+    k_px: f64x4,
     c_px: f64x4,
     k_py: f64x4,
     c_py: f64x4,
@@ -568,18 +569,31 @@ pub struct DiscPadLanes {
     t_ramp: f64x4,
     inv_md: f64x4,
     inv_mp: f64x4,
+    m_p: f64x4,
+    m_sum: f64x4,
     f0: f64x4,
     f1: f64x4,
     two_uc: f64x4,
 }
 
-/// Lane-wise [`Model::rhs`] in slip (either sign) with the thesis friction
-/// law and unilateral contact (the default; any other law or contact: no
-/// pack, every lane one by one). Lanes in stick or free flight are left to
-/// `rhs`. Each lane's slope comes from the same operations, in the same
-/// order, as `rhs` (tested bit for bit).
+/// The modes of four disc–pads as lane masks, for
+/// [`LaneField::field_masked`] (made once per attempt).
+#[derive(Debug, Clone, Copy)]
+pub struct DiscPadMasks {
+    any_stick: bool,
+    neg: f64x4,
+    stick: f64x4,
+    free: f64x4,
+}
+
+/// Lane-wise [`Model::rhs`] in every mode (slip of either sign, stick, free
+/// flight) with the thesis friction law and unilateral contact (the
+/// default; any other law or contact: no pack, every lane one by one). Each
+/// lane's slope comes from the same operations, in the same order, as `rhs`
+/// (tested bit for bit).
 impl LaneField<8> for DiscPad {
     type Pack = DiscPadLanes;
+    type Masks = DiscPadMasks;
 
     fn pack(models: [Option<&Self>; LANES]) -> Option<DiscPadLanes> {
         let first = models.iter().flatten().next()?;
@@ -605,6 +619,7 @@ impl LaneField<8> for DiscPad {
             neg_k_dy: get(&|m| -m.p.k_dy),
             c_dy: get(&|m| m.p.c_dy),
             neg_k_px: get(&|m| -m.p.k_px),
+            k_px: get(&|m| m.p.k_px),
             c_px: get(&|m| m.p.c_px),
             k_py: get(&|m| m.p.k_py),
             c_py: get(&|m| m.p.c_py),
@@ -614,43 +629,77 @@ impl LaneField<8> for DiscPad {
             t_ramp: get(&|m| m.p.t_ramp),
             inv_md: get(&|m| 1.0 / m.p.m_d),
             inv_mp: get(&|m| 1.0 / m.p.m_p),
+            m_p: get(&|m| m.p.m_p),
+            m_sum: get(&|m| m.p.m_d + m.p.m_p),
             f0: f64x4::new(std::array::from_fn(|l| thesis[l].0)),
             f1: f64x4::new(std::array::from_fn(|l| thesis[l].1)),
             two_uc: f64x4::new(std::array::from_fn(|l| thesis[l].2)),
         })
     }
 
-    #[inline(always)]
-    fn field_lanes(
-        p: &DiscPadLanes,
-        t: f64x4,
-        modes: &[Option<Modes>; LANES],
-        z: &[f64x4; 8],
-        dz: &mut [f64x4; 8],
-    ) -> [bool; LANES] {
+    fn masks(modes: &[Option<Modes>; LANES]) -> (DiscPadMasks, [bool; LANES]) {
         let mut neg = [0.0; LANES];
+        let mut stick = [0.0; LANES];
+        let mut free = [0.0; LANES];
         let mut done = [false; LANES];
         for (l, m) in modes.iter().enumerate() {
-            match m.map(|m| m.first()) {
-                Some(Mode::SlipPos) => done[l] = true,
-                Some(Mode::SlipNeg) => (neg[l], done[l]) = (1.0, true),
-                _ => {}
+            let Some(m) = m else { continue };
+            done[l] = true;
+            match m.first() {
+                Mode::SlipPos => {}
+                Mode::SlipNeg => neg[l] = 1.0,
+                Mode::Stick => stick[l] = 1.0,
+                Mode::Free => free[l] = 1.0,
             }
         }
-        if !done.contains(&true) {
-            return done;
-        }
         let zero = f64x4::ZERO;
-        let neg = f64x4::new(neg).cmp_gt(zero);
-        // As `rhs`: F_y (thesis 8.5), v (8.8), s·μ(s·v) with the sign as a
-        // negation, F_t = s·μ·F_y, F_f = α·F_t·y_d.
-        let f_y = p.k_py * (z[YD] - z[YP]) + p.c_py * (z[WD] - z[WP]);
+        let masks = DiscPadMasks {
+            any_stick: stick.contains(&1.0),
+            neg: f64x4::new(neg).cmp_gt(zero),
+            stick: f64x4::new(stick).cmp_gt(zero),
+            free: f64x4::new(free).cmp_gt(zero),
+        };
+        (masks, done)
+    }
+
+    // Every mode lane-wise: each lane's forces as `rhs` computes them in
+    // its mode, picked by masks (the other modes' numbers are computed and
+    // dropped; no lane's operations change).
+    #[inline(always)]
+    fn field_masked(
+        p: &DiscPadLanes,
+        masks: &DiscPadMasks,
+        t: f64x4,
+        z: &[f64x4; 8],
+        dz: &mut [f64x4; 8],
+    ) {
+        let DiscPadMasks {
+            any_stick,
+            neg,
+            stick,
+            free,
+        } = *masks;
+        let zero = f64x4::ZERO;
+        // Slip, as `rhs`: F_y (thesis 8.5), v (8.8), s·μ(s·v) with the sign
+        // as a negation, F_t = s·μ·F_y.
+        let layer = p.k_py * (z[YD] - z[YP]) + p.c_py * (z[WD] - z[WP]);
         let v = p.v + z[UD] - z[UP];
         let sv = neg.blend(-v, v);
         let one = f64x4::splat(1.0);
         let mu = p.f0 * (one - p.f1 * sv * (one - sv / p.two_uc));
         let s_mu = neg.blend(-mu, mu);
-        let f_t = s_mu * f_y;
+        let mut f_t = s_mu * layer;
+        // Stick (MODEL.md §4): the common acceleration `a` and the force
+        // that holds the pad to the disc, as `stick_force`.
+        let mut a = zero;
+        if any_stick {
+            a = (p.neg_k_dx * z[XD] - p.c_dx * z[UD] - p.k_px * z[XP] - p.c_px * z[UP]) / p.m_sum;
+            let f_stick = p.m_p * a + p.k_px * z[XP] + p.c_px * z[UP];
+            f_t = stick.blend(f_stick, f_t);
+        }
+        // Free flight: no contact force.
+        let f_y = free.blend(zero, layer);
+        let f_t = free.blend(zero, f_t);
         let f_f = p.alpha * f_t * z[YD];
         // normal_load: N·max(t/t_ramp, 0) during the ramp, else N.
         let ramping = p.t_ramp.cmp_gt(zero) & t.cmp_lt(p.t_ramp);
@@ -661,8 +710,11 @@ impl LaneField<8> for DiscPad {
         dz[YP] = z[WP];
         dz[UD] = (p.neg_k_dx * z[XD] - p.c_dx * z[UD] - f_t) * p.inv_md;
         dz[UP] = (p.neg_k_px * z[XP] - p.c_px * z[UP] + f_t) * p.inv_mp;
+        if any_stick {
+            dz[UD] = stick.blend(a, dz[UD]);
+            dz[UP] = stick.blend(a, dz[UP]);
+        }
         dz[WD] = (p.neg_k_dy * z[YD] - p.c_dy * z[WD] - f_y + f_f) * p.inv_md;
         dz[WP] = (f_y - load - f_f) * p.inv_mp;
-        done
     }
 }
