@@ -212,15 +212,27 @@ pub fn stability_failure(model: &AnyModel, e: StabilityError) -> StudyError {
     StudyError::Input(InputError(msg))
 }
 
+/// The samples and columns of `sc`'s series (time, states, derived columns).
+fn series_shape(sc: &Scenario) -> (f64, f64) {
+    let rows = sc.duration * sc.sample_rate + 2.0;
+    let cols = (1 + sc.model.state_names().len() + sc.model.derived_columns().len()) as f64;
+    (rows, cols)
+}
+
+/// The memory that `sc`'s series takes (bytes): samples × columns × 8.
+pub fn series_bytes(sc: &Scenario) -> f64 {
+    let (rows, cols) = series_shape(sc);
+    rows * cols * 8.0
+}
+
 /// Check that `sc` can be run, before any work: the series fits in memory,
 /// the sample rate resolves the fastest mode, and the integration needs a
 /// bounded number of steps; then set the run's step budget
 /// (`sc.solver.max_steps`). `what` names the run in messages.
 pub fn prepare(sc: &mut Scenario) -> Result<(), StudyError> {
     sc.validate()?;
-    let rows = sc.duration * sc.sample_rate + 2.0;
-    let cols = (1 + sc.model.state_names().len() + sc.model.derived_columns().len()) as f64;
-    let bytes = rows * cols * 8.0;
+    let (rows, cols) = series_shape(sc);
+    let bytes = series_bytes(sc);
     if bytes > MAX_SERIES_BYTES {
         return Err(InputError(format!(
             "sample_rate = {}: {} s at {} Hz is {rows:.3e} samples × {cols} columns = {:.2} GB in memory \

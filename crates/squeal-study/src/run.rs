@@ -274,6 +274,34 @@ pub fn run(sc: &Scenario, progress: &dyn Progress, cancel: &Cancel) -> Result<Ru
         else => Err(StudyError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))))
 }
 
+/// Most memory (bytes) the series of one [`run_many`] task may hold at once
+/// when grouped by [`tasks`]: the scenarios of an ensemble are in memory
+/// together, so four long runs would take four times one run's memory.
+pub const TASK_SERIES_BYTES: f64 = 256.0 * 1024.0 * 1024.0;
+
+/// The scenarios `scs` cut into consecutive groups for [`run_many`], each
+/// of at most [`LANES`](squeal_core::integrate::ensemble::LANES)
+/// scenarios whose series together take at most [`TASK_SERIES_BYTES`]
+/// (a scenario larger than that alone is a group of one). Grouping changes
+/// no result: `run_many` gives the bits of [`run`] however it is called.
+pub fn tasks<S: Borrow<Scenario>>(scs: &[S]) -> Vec<std::ops::Range<usize>> {
+    let lanes = squeal_core::integrate::ensemble::LANES;
+    let mut out = Vec::new();
+    let (mut start, mut bytes) = (0, 0.0);
+    for (i, sc) in scs.iter().enumerate() {
+        let b = crate::feasible::series_bytes(sc.borrow());
+        if i > start && (i - start == lanes || bytes + b > TASK_SERIES_BYTES) {
+            out.push(start..i);
+            (start, bytes) = (i, 0.0);
+        }
+        bytes += b;
+    }
+    if start < scs.len() {
+        out.push(start..scs.len());
+    }
+    out
+}
+
 /// A [`Progress`] passing on every `inc` but not `finish` (the runs of
 /// [`run_many`] share one bar, finished once when all are done).
 struct Unfinished<'a>(&'a dyn Progress);

@@ -148,3 +148,27 @@ fn run_many_after_cancel_interrupts_every_scenario() {
         assert!(matches!(r, Err(StudyError::Interrupted)), "{r:?}");
     }
 }
+
+/// `tasks` groups at most four scenarios, and never more series memory than
+/// `TASK_SERIES_BYTES` at once (a scenario larger than that runs alone).
+#[test]
+fn tasks_bound_lanes_and_memory() {
+    use squeal_study::feasible::series_bytes;
+    use squeal_study::run::{tasks, TASK_SERIES_BYTES};
+    let small = scenario("disc-pad", &["duration=0.05"]);
+    // 200 kHz for 20 s: 4·10⁶ samples of 13 columns, 416 MB.
+    let big = scenario("disc-pad", &["duration=20", "sample_rate=200000"]);
+    assert!(series_bytes(&small) < 0.1 * TASK_SERIES_BYTES);
+    assert!(series_bytes(&big) > TASK_SERIES_BYTES);
+    let mut list = vec![small.clone(); 6];
+    assert_eq!(tasks(&list), vec![0..4, 4..6]);
+    list.insert(2, big.clone());
+    assert_eq!(tasks(&list), vec![0..2, 2..3, 3..7]);
+    // Two of a third of the budget fit together, the third does not.
+    let third = TASK_SERIES_BYTES / 3.0 + 1.0;
+    let mut mid = big.clone();
+    mid.duration *= third / series_bytes(&big);
+    assert!((series_bytes(&mid) - third).abs() / third < 1e-3);
+    assert_eq!(tasks(&[&mid, &mid, &mid, &small]), vec![0..2, 2..4]);
+    assert!(tasks::<Scenario>(&[]).is_empty());
+}

@@ -69,7 +69,6 @@ pub struct ReproduceArgs {
 }
 
 use crate::commands::merge::{reproduce_study, write_reproduce_part, Shard};
-use squeal_core::integrate::ensemble::LANES;
 use squeal_study::reproduce::*;
 use squeal_study::run::run_many;
 use squeal_study::NoProgress;
@@ -840,11 +839,15 @@ fn measure_sets(
     label: &str,
 ) -> Result<Vec<SetResult>, RunError> {
     let pb = progress_bar(ids.len() as u64, label);
-    let results: Vec<Vec<Result<SetResult, RunError>>> = ids
-        .par_chunks(LANES)
-        .map(|chunk| {
-            let scs: Vec<&Scenario> = chunk.iter().map(|&i| &sets[i]).collect();
-            let runs = run_many(&scs, &NoProgress, &NEVER);
+    // Tasks of up to LANES sets (fewer when their series would take too
+    // much memory together), each one ensemble on its core.
+    let all: Vec<&Scenario> = ids.iter().map(|&i| &sets[i]).collect();
+    let results: Vec<Vec<Result<SetResult, RunError>>> = squeal_study::run::tasks(&all)
+        .into_par_iter()
+        .map(|task| {
+            let chunk = &ids[task.clone()];
+            let scs = &all[task];
+            let runs = run_many(scs, &NoProgress, &NEVER);
             chunk
                 .iter()
                 .zip(runs)
