@@ -828,8 +828,9 @@ fn draw_map(rs: &[SetResult], dir: &Path) -> Result<String, RunError> {
 
 /// Measure the sets `ids` (indices into `sets`, set `i + 1`) in parallel,
 /// drawing Appendix A's pictures into `figures` if given; results in the
-/// order of `ids`, whatever the number of threads. Each task takes
-/// [`LANES`] sets and runs them together on its core
+/// order of `ids`, whatever the number of threads. Each task takes up to
+/// four sets ([`squeal_study::run::tasks`]: fewer when their series would
+/// take too much memory together) and runs them together on its core
 /// ([`run_many`]: the disc–pads as one ensemble, bit for bit their single
 /// runs), then analyses each.
 fn measure_sets(
