@@ -329,7 +329,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             pending_len: 0,
             pending_next: 0,
         };
-        s.enter_mode(modes)?;
+        s.enter_mode(modes, 0)?;
         s.h = match opts.h_init {
             Some(h) if h > 0.0 => h,
             _ => s.initial_step(),
@@ -390,7 +390,17 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
     /// with several contacts, one contact's transition can release another's
     /// stick at the same instant). Guards are tried in order, so simultaneous
     /// transitions resolve deterministically, lowest contact first.
-    fn enter_mode(&mut self, mut modes: Modes) -> Result<(), IntegrateError> {
+    ///
+    /// `broke` has bit `c` set for each contact `c` whose stick just broke at
+    /// this instant: its slip-zero guard does not fire at once. Breakaway
+    /// starts on that guard's surface with a relative acceleration that is
+    /// zero when μ(0⁺) = μ_s (the stick force is the friction bound) and
+    /// points out of stick otherwise, so only round-off could make it fire;
+    /// and where the guard's rate is a single state's slope (a mass on a
+    /// belt of prescribed speed), round-off carries no scale to be judged
+    /// against. Firing would re-stick, the stick would break again at once,
+    /// and the run would end in endless chatter.
+    fn enter_mode(&mut self, mut modes: Modes, mut broke: u64) -> Result<(), IntegrateError> {
         for _ in 0..SETTLE_LIMIT {
             self.modes = modes;
             self.model.mode_guards(&modes, &mut self.guards);
@@ -400,6 +410,9 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             self.f = f;
             let mut fired = None;
             for g in self.guards.as_slice() {
+                if g.kind == GuardKind::SlipZero && broke & (1 << g.contact) != 0 {
+                    continue;
+                }
                 let (val, rate, scale, vscale) = if g.affine {
                     let mut rate = 0.0;
                     let mut scale = 0.0;
@@ -441,6 +454,9 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 }
             }
             let Some(g) = fired else { return Ok(()) };
+            if matches!(g.kind, GuardKind::StickBreakPos | GuardKind::StickBreakNeg) {
+                broke |= 1 << g.contact;
+            }
             let mut z = self.z;
             let (next, ev) = self.model.switch(self.t, &modes, &g, &mut z);
             self.z = z;
@@ -873,7 +889,11 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                     self.note_event(ev)?;
                 }
                 (self.pending_len, self.pending_next) = (0, 0);
-                self.enter_mode(next)?;
+                let broke = match g.kind {
+                    GuardKind::StickBreakPos | GuardKind::StickBreakNeg => 1 << g.contact,
+                    _ => 0,
+                };
+                self.enter_mode(next, broke)?;
                 // A step cut short by an event: restart no larger than the part used.
                 self.h = self.h.min(h);
                 Ok(Segment {
