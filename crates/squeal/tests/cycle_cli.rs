@@ -135,6 +135,39 @@ fn coulomb_belt_branch_over_v_is_exact() {
     assert!(d.path().join("b/branch.png").is_file());
 }
 
+/// The `belt` scenario's branch starting at V = 0.2 m/s, where the cycle is
+/// found by settling from a kick for over 23 s into stick-slip with a
+/// continuous friction law (μ(0⁺) = μ_s). Its first stick used to end the
+/// run in "endless stick-slip chatter" (`crates/squeal-core/tests/breakaway.rs`).
+#[test]
+fn belt_branch_from_slow_belt_settles_into_stick_slip() {
+    let d = tempfile::tempdir().unwrap();
+    let out = squeal(
+        d.path(),
+        &["branch", "belt", "--param", "V=0.2:0.46:2", "--out", "b"],
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(d.path().join("b/summary.json")).unwrap();
+    let j: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(j["failed"].as_array().unwrap().len(), 0, "{}", j["failed"]);
+    let points = j["points"].as_array().unwrap();
+    assert_eq!(points.len(), 2);
+    // One stick and one slip per period, at the natural period 2π/100 s
+    // (m = 1 kg, k = 10⁴ N/m) to within the friction's influence, 0.1 %.
+    let natural = 2.0 * std::f64::consts::PI / 100.0;
+    for p in points {
+        assert_eq!(p["events_per_period"]["stick"], 1);
+        assert_eq!(p["events_per_period"]["slip"], 1);
+        let period = p["period"].as_f64().unwrap();
+        assert!((period / natural - 1.0).abs() < 1e-3, "{period} s");
+    }
+    assert_eq!(points[0]["value"].as_f64(), Some(0.2), "{}", points[0]);
+}
+
 /// `squeal branch` on the belt with `μ(v) = 0.5 + 0.5 exp(−v²)`, m = k = N = 1.
 fn gaussian_branch(dir: &Path, c: &str, range: &str, out: &str) -> serde_json::Value {
     let o = squeal(
