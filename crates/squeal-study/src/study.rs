@@ -321,8 +321,6 @@ pub fn cpx_sweep(
         .filter_map(|mm| tangential(&mm))
         .map(|t| ((t.0 - disc0) / disc0).abs())
         .fold(0.0, f64::max);
-    // The runs go together on this thread (run_many: one ensemble of
-    // disc–pads, bit for bit their single runs).
     let scs: Vec<Scenario> = factors
         .iter()
         .map(|&k| {

@@ -840,8 +840,6 @@ fn measure_sets(
     label: &str,
 ) -> Result<Vec<SetResult>, RunError> {
     let pb = progress_bar(ids.len() as u64, label);
-    // Tasks of up to LANES sets (fewer when their series would take too
-    // much memory together), each one ensemble on its core.
     let all: Vec<&Scenario> = ids.iter().map(|&i| &sets[i]).collect();
     let results: Vec<Vec<Result<SetResult, RunError>>> = squeal_study::run::tasks(&all)
         .into_par_iter()
