@@ -702,8 +702,14 @@ impl LaneField<8> for DiscPad {
         let f_t = free.blend(zero, f_t);
         let f_f = p.alpha * f_t * z[YD];
         // normal_load: N·max(t/t_ramp, 0) during the ramp, else N.
+        // (The quotient only while a lane ramps: the rest of the run pays
+        // no division for it.)
         let ramping = p.t_ramp.cmp_gt(zero) & t.cmp_lt(p.t_ramp);
-        let load = ramping.blend(p.n * (t / p.t_ramp).max(zero), p.n);
+        let load = if ramping.any() {
+            ramping.blend(p.n * (t / p.t_ramp).max(zero), p.n)
+        } else {
+            p.n
+        };
         dz[XD] = z[UD];
         dz[XP] = z[UP];
         dz[YD] = z[WD];
