@@ -3,7 +3,7 @@
 //! lanes that stop early or fail while the others go on.
 
 use squeal_core::integrate::ensemble::{
-    simulate_ensemble, simulate_ensemble_lanes, Job, LaneField, LANES,
+    simulate_ensemble, simulate_ensemble_lanes, Job, LaneField, Lanes, LANES,
 };
 use squeal_core::model::Mode;
 use squeal_core::model::Modes;
@@ -12,7 +12,6 @@ use squeal_core::{
     simulate, Belt, DiscPad, EventKind, Flow, FrictionLaw, IntegrateError, RunInfo, Sink,
     SolverOptions, System,
 };
-use wide::f64x4;
 
 /// A recorder that stops the run after `limit` samples.
 #[derive(Debug, Clone, Default)]
@@ -277,40 +276,41 @@ fn disc_pad_lane_field_is_field_bit_for_bit() {
                 2 => Mode::Free,
                 _ => Mode::SlipPos,
             });
-        let zl: [f64x4; 8] = std::array::from_fn(|i| f64x4::new(std::array::from_fn(|l| z[l][i])));
-        let mut dz = [f64x4::ZERO; 8];
+        let zl: [Lanes; 8] = std::array::from_fn(|i| Lanes::new(std::array::from_fn(|l| z[l][i])));
+        let mut dz = [Lanes::ZERO; 8];
         let lane_modes = modes.map(|m| Some(Modes::single(m)));
-        let done = DiscPad::field_lanes(&pack, f64x4::new(t), &lane_modes, &zl, &mut dz);
+        let done = DiscPad::field_lanes(&pack, Lanes::new(t), &lane_modes, &zl, &mut dz);
         assert_eq!(done, [true; LANES]);
         for l in 0..LANES {
             let mut one = [0.0; 8];
             models[l].field(t[l], &Modes::single(modes[l]), &z[l], &mut one);
             for i in 0..8 {
                 assert_eq!(
-                    dz[i].as_array_ref()[l].to_bits(),
+                    dz[i].lane(l).to_bits(),
                     one[i].to_bits(),
                     "case {case} lane {l} state {i}: {} vs {}",
-                    dz[i].as_array_ref()[l],
+                    dz[i].lane(l),
                     one[i]
                 );
             }
         }
     }
     // Idle lanes are not computed; lanes in any mode are.
-    let zl = [f64x4::ZERO; 8];
-    let mut dz = [f64x4::ZERO; 8];
+    let zl = [Lanes::ZERO; 8];
+    let mut dz = [Lanes::ZERO; 8];
     let mut lane_modes = [None; LANES];
     lane_modes[0] = Some(Modes::single(Mode::SlipPos));
-    let done = DiscPad::field_lanes(&pack, f64x4::ZERO, &lane_modes, &zl, &mut dz);
-    assert_eq!(done, [true, false, false, false]);
+    let done = DiscPad::field_lanes(&pack, Lanes::ZERO, &lane_modes, &zl, &mut dz);
+    let only = |set: &[usize]| -> [bool; LANES] { std::array::from_fn(|l| set.contains(&l)) };
+    assert_eq!(done, only(&[0]));
     lane_modes[1] = Some(Modes::single(Mode::Stick));
     lane_modes[2] = Some(Modes::single(Mode::Free));
-    let done = DiscPad::field_lanes(&pack, f64x4::ZERO, &lane_modes, &zl, &mut dz);
-    assert_eq!(done, [true, true, true, false]);
+    let done = DiscPad::field_lanes(&pack, Lanes::ZERO, &lane_modes, &zl, &mut dz);
+    assert_eq!(done, only(&[0, 1, 2]));
     lane_modes[0] = None;
-    let done = DiscPad::field_lanes(&pack, f64x4::ZERO, &lane_modes, &zl, &mut dz);
-    assert_eq!(done, [false, true, true, false]);
-    let done = DiscPad::field_lanes(&pack, f64x4::ZERO, &[None; LANES], &zl, &mut dz);
+    let done = DiscPad::field_lanes(&pack, Lanes::ZERO, &lane_modes, &zl, &mut dz);
+    assert_eq!(done, only(&[1, 2]));
+    let done = DiscPad::field_lanes(&pack, Lanes::ZERO, &[None; LANES], &zl, &mut dz);
     assert_eq!(done, [false; LANES]);
     let mut strib = models;
     strib[3].friction = FrictionLaw::by_name("stribeck").unwrap();

@@ -25,13 +25,11 @@
 //! A lane whose run ends (finished, stopped by its sink, or failed) takes
 //! the next job at once, so a sweep of many short runs keeps all lanes busy.
 
+pub use super::lanes::{Lanes, LANES};
 use super::tableau::{A, B, C, D, E3, E5};
 use super::{check_rate, Feed, IntegrateError, RunInfo, Sink, Solver, SolverOptions};
 use crate::model::{Modes, System};
-use wide::{f64x4, CmpEq};
 
-/// Lanes of an ensemble: one [`f64x4`] holds a number of each.
-pub const LANES: usize = 4;
 const L: usize = LANES;
 
 /// One run of an ensemble: what [`super::simulate`] takes, per lane.
@@ -58,7 +56,7 @@ pub struct Job<'m, M: System<N> + ?Sized, S: Sink<N>, const N: usize> {
 /// The contract is [`System::field`]'s, lane by lane and bit for bit: each
 /// lane's slope must come from the same IEEE operations in the same order as
 /// `field` on that lane's model, state and time (lane-wise products, sums
-/// and quotients of [`f64x4`] are the scalar ones). A call may leave lanes
+/// and quotients of [`Lanes`] are the scalar ones). A call may leave lanes
 /// out (e.g. a mode it does not cover): those lanes are then evaluated by
 /// [`System::field`].
 pub trait LaneField<const N: usize>: System<N> + Sized {
@@ -81,9 +79,9 @@ pub trait LaneField<const N: usize>: System<N> + Sized {
     fn field_masked(
         pack: &Self::Pack,
         masks: &Self::Masks,
-        t: f64x4,
-        z: &[f64x4; N],
-        dz: &mut [f64x4; N],
+        t: Lanes,
+        z: &[Lanes; N],
+        dz: &mut [Lanes; N],
     );
     /// `dz = f(t, z)` lane by lane, each lane in its own `modes`
     /// (`None`: an idle lane, whose `dz` is not used). Returns the lanes it
@@ -91,10 +89,10 @@ pub trait LaneField<const N: usize>: System<N> + Sized {
     /// again by [`System::field`]).
     fn field_lanes(
         pack: &Self::Pack,
-        t: f64x4,
+        t: Lanes,
         modes: &[Option<Modes>; LANES],
-        z: &[f64x4; N],
-        dz: &mut [f64x4; N],
+        z: &[Lanes; N],
+        dz: &mut [Lanes; N],
     ) -> [bool; LANES] {
         let (masks, done) = Self::masks(modes);
         if done.contains(&true) {
@@ -116,7 +114,7 @@ trait Slopes<M: System<N> + ?Sized, const N: usize> {
     /// [`System::field`]).
     fn masks(&self, modes: &[Option<Modes>; L]) -> (Self::Masks, [bool; L]);
     /// The slopes at `(t, z)` of the lanes it computes, in `dz`.
-    fn lanes(&self, masks: &Self::Masks, t: f64x4, z: &[f64x4; N], dz: &mut [f64x4; N]);
+    fn lanes(&self, masks: &Self::Masks, t: Lanes, z: &[Lanes; N], dz: &mut [Lanes; N]);
 }
 
 /// Every lane's slope by its own model call.
@@ -129,7 +127,7 @@ impl<M: System<N> + ?Sized, const N: usize> Slopes<M, N> for PerLane {
         ((), [false; L])
     }
     #[inline(always)]
-    fn lanes(&self, _masks: &(), _t: f64x4, _z: &[f64x4; N], _dz: &mut [f64x4; N]) {}
+    fn lanes(&self, _masks: &(), _t: Lanes, _z: &[Lanes; N], _dz: &mut [Lanes; N]) {}
 }
 
 /// The lanes' slopes by the model's [`LaneField`].
@@ -152,7 +150,7 @@ impl<M: LaneField<N>, const N: usize> Slopes<M, N> for Packed<M, N> {
         }
     }
     #[inline(always)]
-    fn lanes(&self, masks: &Option<M::Masks>, t: f64x4, z: &[f64x4; N], dz: &mut [f64x4; N]) {
+    fn lanes(&self, masks: &Option<M::Masks>, t: Lanes, z: &[Lanes; N], dz: &mut [Lanes; N]) {
         if let (Some(pack), Some(masks)) = (&self.0, masks) {
             M::field_masked(pack, masks, t, z, dz);
         }
@@ -381,45 +379,48 @@ fn prepare<M: System<N> + ?Sized, const N: usize>(
     Ok(true)
 }
 
-/// The Runge–Kutta arithmetic of the lanes, `[stage][state]` of [`f64x4`]
+/// The Runge–Kutta arithmetic of the lanes, `[stage][state]` of [`Lanes`]
 /// (one number per lane; lane-wise IEEE products and sums, no fused
 /// multiply–add, so each lane's numbers are those of a single run).
 struct Soa<const N: usize> {
-    k: [[f64x4; N]; 16],
-    z: [f64x4; N],
-    z_new: [f64x4; N],
-    e5: [f64x4; N],
-    e3: [f64x4; N],
+    k: [[Lanes; N]; 16],
+    z: [Lanes; N],
+    z_new: [Lanes; N],
+    e5: [Lanes; N],
+    e3: [Lanes; N],
+    /// The dense output's high-order coefficients of the last step.
+    d: [[Lanes; N]; 4],
     t: [f64; L],
-    h: f64x4,
+    h: Lanes,
     /// The lanes' tolerances and norm sizes (as their solvers hold them),
     /// gathered once per change of the lanes' jobs.
-    atol: [f64x4; N],
-    rtol: f64x4,
-    norm_n: f64x4,
+    atol: [Lanes; N],
+    rtol: Lanes,
+    norm_n: Lanes,
     /// The lanes' error norms of the last attempt.
     err: [f64; L],
 }
 
 /// Lane `l` of every state.
 #[inline(always)]
-fn lane_of<const N: usize>(v: &[f64x4; N], l: usize) -> [f64; N] {
-    std::array::from_fn(|i| v[i].as_array_ref()[l])
+fn lane_of<const N: usize>(v: &[Lanes; N], l: usize) -> [f64; N] {
+    std::array::from_fn(|i| v[i].lane(l))
 }
 
 impl<const N: usize> Soa<N> {
     fn new() -> Self {
         Soa {
-            k: [[f64x4::ZERO; N]; 16],
-            z: [f64x4::ZERO; N],
-            z_new: [f64x4::ZERO; N],
-            e5: [f64x4::ZERO; N],
-            e3: [f64x4::ZERO; N],
+            k: [[Lanes::ZERO; N]; 16],
+            z: [Lanes::ZERO; N],
+            z_new: [Lanes::ZERO; N],
+            e5: [Lanes::ZERO; N],
+            e3: [Lanes::ZERO; N],
+            d: [[Lanes::ZERO; N]; 4],
             t: [0.0; L],
-            h: f64x4::ZERO,
-            atol: [f64x4::ONE; N],
-            rtol: f64x4::ONE,
-            norm_n: f64x4::ONE,
+            h: Lanes::ZERO,
+            atol: [Lanes::ONE; N],
+            rtol: Lanes::ONE,
+            norm_n: Lanes::ONE,
             err: [0.0; L],
         }
     }
@@ -427,7 +428,7 @@ impl<const N: usize> Soa<N> {
     /// Gather the lanes' tolerances (idle lanes: ones, never used).
     fn tolerances<M: System<N> + ?Sized>(&mut self, lanes: &[Option<Lane<'_, M, N>>; L]) {
         let of = |f: &dyn Fn(&Solver<'_, M, N>) -> f64| {
-            f64x4::new(std::array::from_fn(|l| {
+            Lanes::new(std::array::from_fn(|l| {
                 lanes[l].as_ref().map_or(1.0, |lane| f(&lane.solver))
             }))
         };
@@ -445,8 +446,19 @@ impl<const N: usize> Soa<N> {
         batch: &Batch<F::Masks>,
         f: &F,
     ) {
-        let y = combine_lanes::<N, S>(&self.k, &self.z, &A[S], self.h);
-        self.slopes(lanes, batch, S, &y, C[S], f);
+        let mut y = [Lanes::ZERO; N];
+        combine_lanes::<N, S>(&self.k, Some(&self.z), &A[S], self.h, &mut y);
+        Self::slopes(
+            &mut self.k[S],
+            &self.t,
+            self.h,
+            lanes,
+            batch,
+            S,
+            &y,
+            C[S],
+            f,
+        );
     }
 
     /// `k[s] = f(t + c·h, y)` of the lanes of `batch` (anything
@@ -454,37 +466,40 @@ impl<const N: usize> Soa<N> {
     /// where it declines. Not inlined: one copy of the right-hand side
     /// serves every stage, so the code stays within the instruction cache.
     #[inline(never)]
+    #[allow(clippy::too_many_arguments)]
     fn slopes<M: System<N> + ?Sized, F: Slopes<M, N>>(
-        &mut self,
+        k_s: &mut [Lanes; N],
+        t: &[f64; L],
+        h: Lanes,
         lanes: &[Option<Lane<'_, M, N>>; L],
         batch: &Batch<F::Masks>,
         s: usize,
-        y: &[f64x4; N],
+        y: &[Lanes; N],
         c: f64,
         f: &F,
     ) {
         if batch.any {
             // The lanes' times, lane-wise: the same sums as below.
-            let t = f64x4::new(self.t);
+            let tl = Lanes::new(*t);
             let tc = if s == 12 {
-                t + self.h
+                tl + h
             } else {
-                t + f64x4::splat(c) * self.h
+                tl + Lanes::splat(c) * h
             };
-            f.lanes(&batch.masks, tc, y, &mut self.k[s]);
+            f.lanes(&batch.masks, tc, y, k_s);
         }
         let (modes, rest) = (&batch.modes, batch.rest);
         if !rest.contains(&true) {
             return;
         }
-        let h = self.h.to_array();
+        let h = h.to_array();
         let mut out = [[0.0; N]; L];
         for l in 0..L {
             if let (Some(lane), Some(m), true) = (&lanes[l], &modes[l], rest[l]) {
                 let tc = if s == 12 {
-                    self.t[l] + h[l]
+                    t[l] + h[l]
                 } else {
-                    self.t[l] + c * h[l]
+                    t[l] + c * h[l]
                 };
                 lane.solver.model.field(tc, m, &lane_of(y, l), &mut out[l]);
             }
@@ -492,8 +507,8 @@ impl<const N: usize> Soa<N> {
         // The lanes evaluated one by one go in with one vector per state
         // (not lane by lane: a vector rebuilt from four scalar stores).
         for i in 0..N {
-            let done_i = self.k[s][i].to_array();
-            self.k[s][i] = f64x4::new(std::array::from_fn(|l| {
+            let done_i = k_s[i].to_array();
+            k_s[i] = Lanes::new(std::array::from_fn(|l| {
                 if rest[l] {
                     out[l][i]
                 } else {
@@ -546,10 +561,10 @@ impl<const N: usize> Soa<N> {
                 f[l] = lane.solver.f;
             }
         }
-        self.h = f64x4::new(h);
+        self.h = Lanes::new(h);
         for i in 0..N {
-            self.z[i] = f64x4::new(std::array::from_fn(|l| z[l][i]));
-            self.k[0][i] = f64x4::new(std::array::from_fn(|l| f[l][i]));
+            self.z[i] = Lanes::new(std::array::from_fn(|l| z[l][i]));
+            self.k[0][i] = Lanes::new(std::array::from_fn(|l| f[l][i]));
         }
         // Stages 1…11 and the slope at the new state: 12 evaluations.
         let batch = Self::batch(lanes, active, 12, fields);
@@ -564,13 +579,12 @@ impl<const N: usize> Soa<N> {
         self.stage::<M, F, 9>(lanes, &batch, fields);
         self.stage::<M, F, 10>(lanes, &batch, fields);
         self.stage::<M, F, 11>(lanes, &batch, fields);
-        let z_new = combine_lanes::<N, 12>(&self.k, &self.z, &B, self.h);
-        self.slopes(lanes, &batch, 12, &z_new, 1.0, fields);
-        self.z_new = z_new;
-        let zero = [f64x4::ZERO; N];
-        let one = f64x4::splat(1.0);
-        self.e5 = combine_lanes::<N, 13>(&self.k, &zero, &E5, one);
-        self.e3 = combine_lanes::<N, 13>(&self.k, &zero, &E3, one);
+        combine_lanes::<N, 12>(&self.k, Some(&self.z), &B, self.h, &mut self.z_new);
+        let (k12, t, h) = (&mut self.k[12], &self.t, self.h);
+        Self::slopes(k12, t, h, lanes, &batch, 12, &self.z_new, 1.0, fields);
+        let one = Lanes::splat(1.0);
+        combine_lanes::<N, 13>(&self.k, None, &E5, one, &mut self.e5);
+        combine_lanes::<N, 13>(&self.k, None, &E3, one, &mut self.e3);
         self.err = self.error_norms();
     }
 
@@ -578,15 +592,15 @@ impl<const N: usize> Soa<N> {
     /// the same order, lane-wise (`max` chooses the other lane of a NaN,
     /// as `f64::max` does; `x·x` is `powi(2)`).
     fn error_norms(&self) -> [f64; L] {
-        let (mut err5, mut err3) = (f64x4::ZERO, f64x4::ZERO);
+        let (mut err5, mut err3) = (Lanes::ZERO, Lanes::ZERO);
         for i in 0..N {
             let sk = self.atol[i] + self.rtol * self.z[i].abs().max(self.z_new[i].abs());
             let (a, b) = (self.e5[i] / sk, self.e3[i] / sk);
             err5 += a * a;
             err3 += b * b;
         }
-        let norm = self.h.abs() * err5 / ((err5 + f64x4::splat(0.01) * err3) * self.norm_n).sqrt();
-        let zero = f64x4::ZERO;
+        let norm = self.h.abs() * err5 / ((err5 + Lanes::splat(0.01) * err3) * self.norm_n).sqrt();
+        let zero = Lanes::ZERO;
         let both_zero = err5.cmp_eq(zero) & err3.cmp_eq(zero);
         both_zero.blend(zero, norm).to_array()
     }
@@ -614,13 +628,12 @@ impl<const N: usize> Soa<N> {
         self.stage::<M, F, 13>(lanes, &batch, f);
         self.stage::<M, F, 14>(lanes, &batch, f);
         self.stage::<M, F, 15>(lanes, &batch, f);
-        let zero = [f64x4::ZERO; N];
-        let d: [[f64x4; N]; 4] = [
-            combine_lanes::<N, 16>(&self.k, &zero, &D[0], self.h),
-            combine_lanes::<N, 16>(&self.k, &zero, &D[1], self.h),
-            combine_lanes::<N, 16>(&self.k, &zero, &D[2], self.h),
-            combine_lanes::<N, 16>(&self.k, &zero, &D[3], self.h),
-        ];
+        let d = &mut self.d;
+        combine_lanes::<N, 16>(&self.k, None, &D[0], self.h, &mut d[0]);
+        combine_lanes::<N, 16>(&self.k, None, &D[1], self.h, &mut d[1]);
+        combine_lanes::<N, 16>(&self.k, None, &D[2], self.h, &mut d[2]);
+        combine_lanes::<N, 16>(&self.k, None, &D[3], self.h, &mut d[3]);
+        let d = &self.d;
         for (l, lane) in lanes.iter_mut().enumerate() {
             let (Some(lane), true) = (lane, accepted[l]) else {
                 continue;
@@ -640,24 +653,24 @@ impl<const N: usize> Soa<N> {
 /// for bit those of a single run.
 #[inline(always)]
 fn combine_lanes<const N: usize, const J: usize>(
-    k: &[[f64x4; N]; 16],
-    base: &[f64x4; N],
+    k: &[[Lanes; N]; 16],
+    base: Option<&[Lanes; N]>,
     row: &[f64],
-    h: f64x4,
-) -> [f64x4; N] {
+    h: Lanes,
+    y: &mut [Lanes; N],
+) {
     // State by state, the terms innermost: one state's lanes stay in a
     // register while its terms are added (all states at once would spill).
-    let mut a = [f64x4::ZERO; 16];
-    let mut y = *base;
+    let mut a = [Lanes::ZERO; 16];
     macro_rules! unrolled {
         ($($j:literal)*) => {
             $(
                 if $j < J && row[$j] != 0.0 {
-                    a[$j] = h * f64x4::splat(row[$j]);
+                    a[$j] = h * Lanes::splat(row[$j]);
                 }
             )*
             for i in 0..N {
-                let mut yi = y[i];
+                let mut yi = base.map_or(Lanes::ZERO, |b| b[i]);
                 $(
                     if $j < J && row[$j] != 0.0 {
                         yi += a[$j] * k[$j][i];
@@ -668,5 +681,4 @@ fn combine_lanes<const N: usize, const J: usize>(
         };
     }
     unrolled!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15);
-    y
 }

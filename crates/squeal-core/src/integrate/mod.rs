@@ -15,6 +15,7 @@
 
 pub mod budget;
 pub mod ensemble;
+pub mod lanes;
 pub mod roots;
 mod tableau;
 

@@ -10,9 +10,8 @@ use super::{
     Parameters,
 };
 use crate::friction::FrictionLaw;
-use crate::integrate::ensemble::{LaneField, LANES};
+use crate::integrate::ensemble::{LaneField, Lanes, LANES};
 use crate::params::{ParamError, ParamKind, ParamSpec};
-use wide::{f64x4, CmpGt, CmpLt};
 
 /// Unilateral (the pad can lift off) or bilateral (never opens) contact.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -550,40 +549,40 @@ impl Model<8> for DiscPad {
     }
 }
 
-/// The parameters of four disc–pads, lane by lane, for
+/// The parameters of [`LANES`] disc–pads, lane by lane, for
 /// [`LaneField::field_lanes`] (gathered once per change of the lanes' jobs).
 #[derive(Debug, Clone, Copy)]
 pub struct DiscPadLanes {
-    neg_k_dx: f64x4,
-    c_dx: f64x4,
-    neg_k_dy: f64x4,
-    c_dy: f64x4,
-    neg_k_px: f64x4,
-    k_px: f64x4,
-    c_px: f64x4,
-    k_py: f64x4,
-    c_py: f64x4,
-    n: f64x4,
-    v: f64x4,
-    alpha: f64x4,
-    t_ramp: f64x4,
-    inv_md: f64x4,
-    inv_mp: f64x4,
-    m_p: f64x4,
-    m_sum: f64x4,
-    f0: f64x4,
-    f1: f64x4,
-    two_uc: f64x4,
+    neg_k_dx: Lanes,
+    c_dx: Lanes,
+    neg_k_dy: Lanes,
+    c_dy: Lanes,
+    neg_k_px: Lanes,
+    k_px: Lanes,
+    c_px: Lanes,
+    k_py: Lanes,
+    c_py: Lanes,
+    n: Lanes,
+    v: Lanes,
+    alpha: Lanes,
+    t_ramp: Lanes,
+    inv_md: Lanes,
+    inv_mp: Lanes,
+    m_p: Lanes,
+    m_sum: Lanes,
+    f0: Lanes,
+    f1: Lanes,
+    two_uc: Lanes,
 }
 
-/// The modes of four disc–pads as lane masks, for
+/// The modes of [`LANES`] disc–pads as lane masks, for
 /// [`LaneField::field_masked`] (made once per attempt).
 #[derive(Debug, Clone, Copy)]
 pub struct DiscPadMasks {
     any_stick: bool,
-    neg: f64x4,
-    stick: f64x4,
-    free: f64x4,
+    neg: Lanes,
+    stick: Lanes,
+    free: Lanes,
 }
 
 /// Lane-wise [`Model::rhs`] in every mode (slip of either sign, stick, free
@@ -612,7 +611,7 @@ impl LaneField<8> for DiscPad {
                 _ => return None,
             }
         }
-        let get = |f: &dyn Fn(&DiscPad) -> f64| f64x4::new(std::array::from_fn(|l| f(&lanes[l])));
+        let get = |f: &dyn Fn(&DiscPad) -> f64| Lanes::new(std::array::from_fn(|l| f(&lanes[l])));
         Some(DiscPadLanes {
             neg_k_dx: get(&|m| -m.p.k_dx),
             c_dx: get(&|m| m.p.c_dx),
@@ -631,9 +630,9 @@ impl LaneField<8> for DiscPad {
             inv_mp: get(&|m| 1.0 / m.p.m_p),
             m_p: get(&|m| m.p.m_p),
             m_sum: get(&|m| m.p.m_d + m.p.m_p),
-            f0: f64x4::new(std::array::from_fn(|l| thesis[l].0)),
-            f1: f64x4::new(std::array::from_fn(|l| thesis[l].1)),
-            two_uc: f64x4::new(std::array::from_fn(|l| thesis[l].2)),
+            f0: Lanes::new(std::array::from_fn(|l| thesis[l].0)),
+            f1: Lanes::new(std::array::from_fn(|l| thesis[l].1)),
+            two_uc: Lanes::new(std::array::from_fn(|l| thesis[l].2)),
         })
     }
 
@@ -652,12 +651,12 @@ impl LaneField<8> for DiscPad {
                 Mode::Free => free[l] = 1.0,
             }
         }
-        let zero = f64x4::ZERO;
+        let zero = Lanes::ZERO;
         let masks = DiscPadMasks {
             any_stick: stick.contains(&1.0),
-            neg: f64x4::new(neg).cmp_gt(zero),
-            stick: f64x4::new(stick).cmp_gt(zero),
-            free: f64x4::new(free).cmp_gt(zero),
+            neg: Lanes::new(neg).cmp_gt(zero),
+            stick: Lanes::new(stick).cmp_gt(zero),
+            free: Lanes::new(free).cmp_gt(zero),
         };
         (masks, done)
     }
@@ -669,9 +668,9 @@ impl LaneField<8> for DiscPad {
     fn field_masked(
         p: &DiscPadLanes,
         masks: &DiscPadMasks,
-        t: f64x4,
-        z: &[f64x4; 8],
-        dz: &mut [f64x4; 8],
+        t: Lanes,
+        z: &[Lanes; 8],
+        dz: &mut [Lanes; 8],
     ) {
         let DiscPadMasks {
             any_stick,
@@ -679,13 +678,13 @@ impl LaneField<8> for DiscPad {
             stick,
             free,
         } = *masks;
-        let zero = f64x4::ZERO;
+        let zero = Lanes::ZERO;
         // Slip, as `rhs`: F_y (thesis 8.5), v (8.8), s·μ(s·v) with the sign
         // as a negation, F_t = s·μ·F_y.
         let layer = p.k_py * (z[YD] - z[YP]) + p.c_py * (z[WD] - z[WP]);
         let v = p.v + z[UD] - z[UP];
         let sv = neg.blend(-v, v);
-        let one = f64x4::splat(1.0);
+        let one = Lanes::splat(1.0);
         let mu = p.f0 * (one - p.f1 * sv * (one - sv / p.two_uc));
         let s_mu = neg.blend(-mu, mu);
         let mut f_t = s_mu * layer;
