@@ -98,6 +98,26 @@ pub enum IntegrateError {
         /// Gap threshold (s).
         gap: f64,
     },
+    /// A guard fires again and again at one instant without changing any
+    /// mode: the model decides that the contact goes on as it was, but its
+    /// motion crosses the guard at once (at `v_rel = 0`, neither sticking
+    /// nor slipping on in the direction the stick force gives is consistent
+    /// with the other contacts' forces). The run cannot go on.
+    #[error(
+        "no progress at t = {t:.9e} s: contact {contact}'s {surface} guard fired {count} times in a row \
+         without changing its mode (stick is not admissible there, and slipping on in the \
+         direction the model chooses crosses the guard at once)"
+    )]
+    Stalled {
+        /// Time (s).
+        t: f64,
+        /// The contact's name.
+        contact: String,
+        /// Its guard's surface (`v_rel = 0`, `stick bound`, `F_n = 0`, `gap = 0`).
+        surface: &'static str,
+        /// Transitions in a row without progress.
+        count: u32,
+    },
     /// The state became NaN or infinite.
     #[error("the state became non-finite at t = {t:.9e} s")]
     NonFinite {
@@ -241,6 +261,8 @@ pub struct Solver<'m, M: System<N> + ?Sized, const N: usize> {
     stats: Stats,
     last_event_t: f64,
     zeno_run: u32,
+    /// Transitions in a row that changed no mode and advanced no time.
+    stall_run: u32,
     /// Events fired while settling a mode (at most [`SETTLE_LIMIT`]), oldest first.
     pending: [Pending<N>; SETTLE_LIMIT],
     pending_len: usize,
@@ -326,6 +348,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             stats: Stats::default(),
             last_event_t: f64::NEG_INFINITY,
             zeno_run: 0,
+            stall_run: 0,
             pending: [(EventKind::Stick, 0, [0.0; N], modes); SETTLE_LIMIT],
             pending_len: 0,
             pending_next: 0,
@@ -889,6 +912,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 if let Some(ev) = ev {
                     self.note_event(ev)?;
                 }
+                self.note_progress(t0, t1, next == modes && ev.is_none(), &g)?;
                 (self.pending_len, self.pending_next) = (0, 0);
                 let broke = match g.kind {
                     GuardKind::StickBreakPos | GuardKind::StickBreakNeg => 1 << g.contact,
@@ -908,6 +932,40 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 })
             }
         }
+    }
+
+    /// Count transitions that change nothing at the instant they start from
+    /// (a guard re-firing where its model keeps the mode): as many in a row
+    /// as chatter needs ([`SolverOptions::zeno_count`]) end the run with
+    /// [`IntegrateError::Stalled`] rather than spending its step budget
+    /// standing still.
+    fn note_progress(
+        &mut self,
+        t0: f64,
+        t1: f64,
+        unchanged: bool,
+        g: &Guard<N>,
+    ) -> Result<(), IntegrateError> {
+        if !(unchanged && t1 - t0 < self.opts.zeno_gap) {
+            self.stall_run = 0;
+            return Ok(());
+        }
+        self.stall_run += 1;
+        if self.stall_run < self.opts.zeno_count {
+            return Ok(());
+        }
+        let surface = match g.kind {
+            GuardKind::SlipZero => "v_rel = 0",
+            GuardKind::StickBreakPos | GuardKind::StickBreakNeg => "stick bound",
+            GuardKind::Separation => "F_n = 0",
+            GuardKind::Contact => "gap = 0",
+        };
+        Err(IntegrateError::Stalled {
+            t: t1,
+            contact: self.model.contact_name(g.contact as usize).to_string(),
+            surface,
+            count: self.stall_run,
+        })
     }
 
     /// Add `dt` to the time statistics of the current modes.

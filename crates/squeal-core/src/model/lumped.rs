@@ -2205,6 +2205,7 @@ impl Lumped {
 /// [`padding`]). Stability analysis works for any size.
 pub const MAX_SIM_DOFS: usize = 64;
 
+pub mod lanes;
 pub mod padding;
 pub use padding::{embed, padded_dofs, padded_solver, real_states, MAX_EXACT_DOFS, PADDED_DOFS};
 
