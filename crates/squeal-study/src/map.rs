@@ -13,8 +13,9 @@ use crate::error::{Cancel, Progress, StudyError};
 use crate::model::AnyModel;
 use crate::scenario::{InputError, Scenario};
 use rayon::prelude::*;
-use squeal_core::integrate::ensemble::{simulate_ensemble_lanes, Job};
+use squeal_core::integrate::ensemble::{simulate_ensemble_lanes, Job, LaneField};
 use squeal_core::integrate::{Flow, Sink};
+use squeal_core::model::lumped::{Fixed, MAX_EXACT_DOFS};
 use squeal_core::stability::StabilityError;
 use squeal_core::{simulate, EventKind, IntegrateError, Mode, RunInfo};
 use squeal_core::{DiscPad, System};
@@ -22,9 +23,10 @@ use squeal_core::{DiscPad, System};
 /// Points per progress report of a linear grid.
 const CHUNK: usize = 256;
 
-/// Points per task of a transient grid: a task's disc–pad points run four
-/// at a time on its core ([`simulate_ensemble_lanes`]; a lane whose point
-/// is decided takes the task's next point), the others one by one.
+/// Points per task of a transient grid: a task's disc–pad and small lumped
+/// points run four at a time on its core ([`simulate_ensemble_lanes`]; a
+/// lane whose point is decided takes the task's next point), the others
+/// one by one.
 const TRANSIENT_CHUNK: usize = 16;
 
 /// One grid axis.
@@ -355,8 +357,8 @@ fn transient_point<M: System<N>, const N: usize>(
 /// simulation per point, stopped early once its class is certain; one
 /// [`Outcome`] per point in the order given (`failed` where the point
 /// cannot run). The points go in tasks of 16, whose
-/// disc–pads run as an ensemble on one core (the same bits as one at a
-/// time). `progress` counts points; `cancel` is looked at before every task
+/// disc–pads and small lumped models run as an ensemble on one core (the
+/// same bits as one at a time). `progress` counts points; `cancel` is looked at before every task
 /// and ends the map with [`StudyError::Interrupted`].
 pub fn transient_grid(
     sc: &Scenario,
@@ -383,42 +385,94 @@ pub fn transient_grid(
 
 /// The points of one task of [`transient_grid`]: each exactly as
 /// [`transient_at`] computes it (the ensemble's runs are bit for bit the
-/// single runs), the disc–pads four at a time.
+/// single runs). Disc–pads and lumped models of at most
+/// [`MAX_EXACT_DOFS`](squeal_core::model::lumped::MAX_EXACT_DOFS) dofs run
+/// [`LANES`](squeal_core::integrate::ensemble::LANES) at a time, the others
+/// one by one.
 fn transient_chunk(sc: &Scenario, x: &Axis, y: &Axis, chunk: &[usize]) -> Vec<Outcome> {
     let mut out = vec![Outcome::FAILED; chunk.len()];
     let mut discs: Vec<(usize, Scenario)> = Vec::new();
+    let mut lumped: Vec<(usize, Scenario)> = Vec::new();
     for (n, &k) in chunk.iter().enumerate() {
         match prepared(sc, x, y, k) {
-            Ok(s) if matches!(s.model, AnyModel::DiscPad(_)) && s.sample_rate == sc.sample_rate => {
-                discs.push((n, s))
+            Ok(s) if s.sample_rate != sc.sample_rate => {
+                out[n] = run_prepared(&s).unwrap_or(Outcome::FAILED)
+            }
+            Ok(s) if matches!(s.model, AnyModel::DiscPad(_)) => discs.push((n, s)),
+            Ok(s) if matches!(&s.model, AnyModel::Lumped(l) if l.dof_count() <= MAX_EXACT_DOFS) => {
+                lumped.push((n, s))
             }
             Ok(s) => out[n] = run_prepared(&s).unwrap_or(Outcome::FAILED),
             Err(_) => {}
         }
     }
-    let mut jobs: Vec<Job<'_, DiscPad, Watch, 8>> = Vec::new();
+    let discs: Vec<(usize, &Scenario, &DiscPad)> = discs
+        .iter()
+        .filter_map(|(n, s)| match &s.model {
+            AnyModel::DiscPad(m) => Some((*n, s, m)),
+            _ => None,
+        })
+        .collect();
+    run_lanes(&discs, sc.sample_rate, &mut out);
+    // A map's lumped points share their model's structure, so one size.
+    if let Some((_, first)) = lumped.first() {
+        if let AnyModel::Lumped(l) = &first.model {
+            squeal_core::with_lumped_size!(&**l, m => lumped_lanes(m, &lumped, sc.sample_rate, &mut out),
+            else => for (n, s) in &lumped {
+                out[*n] = run_prepared(s).unwrap_or(Outcome::FAILED);
+            });
+        }
+    }
+    out
+}
+
+/// [`run_lanes`] for lumped models of the size of `_size` (any of
+/// another size runs one by one).
+fn lumped_lanes<const N: usize>(
+    _size: &Fixed<'_, N>,
+    points: &[(usize, Scenario)],
+    sample_rate: f64,
+    out: &mut [Outcome],
+) {
+    let mut fixed = Vec::new();
+    for (n, s) in points {
+        match &s.model {
+            AnyModel::Lumped(l) if 2 * l.dof_count() == N => fixed.push((*n, s, Fixed::<N>(l))),
+            _ => out[*n] = run_prepared(s).unwrap_or(Outcome::FAILED),
+        }
+    }
+    let fixed: Vec<(usize, &Scenario, &Fixed<'_, N>)> =
+        fixed.iter().map(|(n, s, m)| (*n, *s, m)).collect();
+    run_lanes(&fixed, sample_rate, out);
+}
+
+/// The transient runs of `points` (slot in `out`, prepared scenario, its
+/// model) as one ensemble ([`simulate_ensemble_lanes`]): each outcome
+/// exactly as [`transient_at`]'s.
+fn run_lanes<M: LaneField<N>, const N: usize>(
+    points: &[(usize, &Scenario, &M)],
+    sample_rate: f64,
+    out: &mut [Outcome],
+) {
+    let mut jobs: Vec<Job<'_, M, Watch, N>> = Vec::new();
     let mut slots = Vec::new();
-    for (n, s) in &discs {
-        let AnyModel::DiscPad(m) = &s.model else {
-            continue;
-        };
+    for &(n, s, m) in points {
         if let Ok((sink, z0)) = watch_for(m, s) {
             jobs.push(Job {
                 model: m,
                 t0: 0.0,
                 z0,
                 t_end: s.duration,
-                opts: crate::run::sim_options::<8>(s),
+                opts: crate::run::sim_options::<N>(s),
                 sink,
             });
-            slots.push(*n);
+            slots.push(n);
         }
     }
-    let results = simulate_ensemble_lanes(&mut jobs, sc.sample_rate);
+    let results = simulate_ensemble_lanes(&mut jobs, sample_rate);
     for ((job, r), n) in jobs.iter().zip(results).zip(slots) {
         out[n] = classify(&job.sink, r).unwrap_or(Outcome::FAILED);
     }
-    out
 }
 
 /// The scenario of point `k`: both parameters set, validated, and checked

@@ -164,3 +164,42 @@ fn a_cancel_set_during_a_run_stops_it_early() {
         p.1.load(Ordering::Relaxed)
     );
 }
+
+/// A transient grid of lumped models (the user's own brake) runs them four
+/// at a time too (the lumped lane-wise right-hand side); every outcome is
+/// bit for bit `transient_at`'s. The thesis disc–pad as a lumped model (one
+/// contact) and the two-pad brake (two contacts), over speeds and loads
+/// that slide steadily, grow and stick–slip.
+#[test]
+fn lumped_transient_grid_equals_one_point_at_a_time() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios/lumped/");
+    for (file, xs, ys) in [
+        ("disc-pad.toml", "pad.V=0.3:9:5", "brake.value=-4000:-100:3"),
+        (
+            "two-pad-brake.toml",
+            "pad1.f0=0.1:0.4:4",
+            "brake_1.value=-2000:-200:3",
+        ),
+    ] {
+        let path = format!("{root}{file}");
+        let sc = resolve_run(Source::Spec(&path), &[], Some(0.02)).unwrap();
+        let x = map::parse_axis(xs, "--x", false, &sc.model).unwrap();
+        let y = map::parse_axis(ys, "--y", false, &sc.model).unwrap();
+        let points = map::all_points(&x, &y);
+        let grid = map::transient_grid(&sc, &x, &y, &points, &NoProgress, &Cancel::new()).unwrap();
+        for (k, o) in points.iter().zip(&grid) {
+            let one = map::transient_at(&sc, &x, &y, *k);
+            assert_eq!(one.class, o.class, "{file} point {k}");
+            for (a, b) in [
+                (one.rms, o.rms),
+                (one.t_end, o.t_end),
+                (one.stick_fraction, o.stick_fraction),
+            ] {
+                assert_eq!(a.to_bits(), b.to_bits(), "{file} point {k}: {a} vs {b}");
+            }
+        }
+        let classes: Vec<&str> = grid.iter().map(|o| o.class).collect();
+        assert!(!classes.contains(&"failed"), "{file}: {classes:?}");
+        assert!(classes.contains(&"stick-slip"), "{file}: {classes:?}");
+    }
+}
