@@ -572,3 +572,34 @@ fn sweep_of_the_lumped_hoffmann_finds_the_built_ins_coalescence() {
     assert!((x - y).abs() <= 1e-9 * y, "{x} vs {y}");
     assert!(d.path().join("a/sweep.csv").is_file());
 }
+
+/// A two-pad brake pressed hard with high friction reaches a state where
+/// a contact can neither stick nor slip on: the run ends at once with the
+/// time and the contact (exit 1, nothing written), rather than standing
+/// still until its step budget runs out and blaming stiffness.
+#[test]
+fn a_contact_that_can_neither_stick_nor_slip_on_is_named_at_once() {
+    let d = tempfile::tempdir().unwrap();
+    let f = scenarios().join("two-pad-brake.toml");
+    let mut args = vec!["simulate", f.to_str().unwrap(), "--duration", "0.005"];
+    for s in [
+        "pad1.V=0.05",
+        "pad2.V=0.05",
+        "pad1.f0=0.5",
+        "pad2.f0=0.5",
+        "brake_1.value=-3000",
+        "brake_2.value=3000",
+    ] {
+        args.extend(["--set", s]);
+    }
+    args.extend(["--out", "o"]);
+    let out = squeal(d.path(), &args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("no progress at t = 1.975540758e-4 s: contact pad1's v_rel = 0 guard fired 100 times in a row"),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(!d.path().join("o").exists(), "nothing is written");
+}
