@@ -4,9 +4,11 @@
 
 use squeal_core::initial::{initial_state, Initial};
 use squeal_core::model::disc_pad::Contact;
+use squeal_core::model::{GuardKind, Modes};
 use squeal_core::sink::{EventLog, Recorder};
 use squeal_core::{
-    simulate, Belt, DiscPad, EventKind, FrictionLaw, Mode, Model, Parameters, SolverOptions,
+    simulate, Belt, DiscPad, EventKind, FrictionLaw, IntegrateError, Mode, Model, Parameters,
+    SolverOptions,
 };
 
 /// The exact Coulomb stick-slip cycle of the undamped belt (derived in the
@@ -513,4 +515,101 @@ fn endless_chatter_is_reported_with_its_time() {
         other => panic!("expected chatter, got {other:?}"),
     }
     assert!(err.to_string().contains("t = 1.000000000e-3"), "{err}");
+}
+
+/// A model whose transition keeps its mode and puts the state back a
+/// round-off below its guard (`x = 1 − 1e-17·…`, moving up at 1 m/s): the
+/// guard crosses again within the same instant, without end.
+struct Stubborn;
+
+impl squeal_core::model::System<2> for Stubborn {
+    fn system_name(&self) -> &str {
+        "stubborn"
+    }
+    fn names(&self) -> Vec<String> {
+        vec!["x".into(), "v".into()]
+    }
+    fn contacts(&self) -> usize {
+        1
+    }
+    fn contact_name(&self, _i: usize) -> &str {
+        "wall"
+    }
+    fn field(&self, _t: f64, _modes: &Modes, z: &[f64; 2], dz: &mut [f64; 2]) {
+        *dz = [z[1], 0.0];
+    }
+    fn mode_guards(&self, _modes: &Modes, out: &mut squeal_core::model::Guards<2>) {
+        out.clear();
+        out.push(GuardKind::SlipZero, [1.0, 0.0], -1.0);
+    }
+    fn switch(
+        &self,
+        _t: f64,
+        modes: &Modes,
+        _g: &squeal_core::model::Guard<2>,
+        z: &mut [f64; 2],
+    ) -> (Modes, Option<EventKind>) {
+        z[0] = 1.0 - f64::EPSILON;
+        (*modes, None)
+    }
+    fn start_modes(&self, _t: f64, _z: &[f64; 2]) -> Modes {
+        Modes::single(Mode::SlipPos)
+    }
+    fn observe_contact(
+        &self,
+        _t: f64,
+        _modes: &Modes,
+        z: &[f64; 2],
+        _i: usize,
+    ) -> squeal_core::model::Observables {
+        squeal_core::model::Observables {
+            normal_force: 0.0,
+            friction_force: 0.0,
+            v_rel: z[1],
+        }
+    }
+    fn steady_sliding(&self) -> Result<[f64; 2], squeal_core::model::ModelError> {
+        Err(squeal_core::model::ModelError::NoSteadySliding(
+            "a test model".into(),
+        ))
+    }
+    fn state_jacobian(&self, _z: &[f64; 2]) -> [[f64; 2]; 2] {
+        [[0.0, 1.0], [0.0, 0.0]]
+    }
+}
+
+#[test]
+fn a_guard_that_fires_again_without_changing_a_mode_ends_the_run() {
+    // Before IntegrateError::Stalled the run took zero-length steps until
+    // its step budget ran out (here 10⁶ of them).
+    let opts = SolverOptions {
+        max_steps: 1_000_000,
+        ..SolverOptions::default()
+    };
+    let err = simulate(
+        &Stubborn,
+        0.0,
+        [0.0, 1.0],
+        2.0,
+        100.0,
+        opts,
+        &mut Recorder::default(),
+    )
+    .expect_err("the run cannot go on");
+    match &err {
+        IntegrateError::Stalled {
+            t,
+            contact,
+            surface,
+            count,
+        } => {
+            assert!((t - 1.0).abs() < 1e-12, "at the wall: {t}");
+            assert_eq!(
+                (contact.as_str(), *surface, *count),
+                ("wall", "v_rel = 0", 100)
+            );
+        }
+        other => panic!("expected a stall, got {other}"),
+    }
+    assert!(err.to_string().starts_with("no progress at t = 1.000000000e0 s: contact wall's v_rel = 0 guard fired 100 times in a row"), "{err}");
 }

@@ -6,9 +6,7 @@ use squeal_core::integrate::ensemble::{simulate_ensemble_lanes, Job, LaneField, 
 use squeal_core::model::lumped::{ContactSpec, Fixed, ForceSpec, LumpedSpec, SpringSpec};
 use squeal_core::model::System;
 use squeal_core::sink::Recorder;
-use squeal_core::{
-    simulate, EventKind, FrictionLaw, IntegrateError, Lumped, Mode, Modes, SolverOptions,
-};
+use squeal_core::{simulate, EventKind, FrictionLaw, Lumped, Mode, Modes, SolverOptions};
 
 fn terms(t: &[(&str, f64)]) -> Vec<(String, f64)> {
     t.iter().map(|(n, v)| (n.to_string(), *v)).collect()
@@ -253,46 +251,38 @@ fn lumped_ensemble_is_single_runs_bit_for_bit() {
         sticks > 20,
         "the hard-pressed brakes stick ({sticks} sticks)"
     );
-    assert!(failed < LANES, "most runs end ({failed} failed)");
+    assert_eq!(failed, 0, "every run ends");
 }
 
 #[test]
-fn a_contact_that_can_neither_stick_nor_slip_on_ends_the_run_at_once() {
-    // The first brake pressed with 3 kN: at t = 8.0912e-4 s pad2 reaches v_rel = 0
-    // where stick is not admissible and slipping on (the direction its
-    // stick force gives) drives v_rel below zero at once. Before this was an
-    // error the run stood still there until its step budget ran out.
-    let m = &light_and_hard(3000.0)[LANES];
+fn hard_pressed_two_pad_brakes_stick_and_slip_to_the_end() {
+    // At t = 8.0912e-4 s the first brake pressed with 3 kN brings pad2 to
+    // v_rel = 0, where it sticks (its stick force is well within μ_s·F_n).
+    // The state projected onto v_rel = 0 still gave V + t·q̇ ≈ −7e-18 by
+    // round-off, whose sign chose "slip on, negative": the guard fired again
+    // at once, and the run stood still until its step budget ran out. Every
+    // brake of this set now runs to the end, sticking and slipping.
     let opts = SolverOptions {
         max_steps: 300_000,
         ..SolverOptions::default()
     };
-    let err = simulate(
-        &Fixed::<12>(m),
-        0.0,
-        [0.0; 12],
-        0.02,
-        50_000.0,
-        opts,
-        &mut Recorder::default(),
-    )
-    .expect_err("the run cannot go on");
-    match err {
-        IntegrateError::Stalled {
-            t,
-            ref contact,
-            surface,
-            count,
-        } => {
-            assert!((t - 8.091224541e-4).abs() < 1e-12, "at {t}");
-            assert_eq!(
-                (contact.as_str(), surface, count),
-                ("pad2", "v_rel = 0", 100)
-            );
-        }
-        other => panic!("expected a stall, got {other}"),
+    for (k, m) in light_and_hard(3000.0)[LANES..].iter().enumerate() {
+        let mut log = Recorder::default();
+        let info = simulate(
+            &Fixed::<12>(m),
+            0.0,
+            [0.0; 12],
+            0.02,
+            50_000.0,
+            opts,
+            &mut log,
+        )
+        .unwrap_or_else(|e| panic!("brake {k}: {e}"));
+        assert_eq!(info.t_final, 0.02);
+        assert!(
+            info.stats.events[0] > 20,
+            "brake {k} sticks: {:?}",
+            info.stats.events
+        );
     }
-    assert!(err
-        .to_string()
-        .starts_with("no progress at t = 8.091224541e-4 s: contact pad2's v_rel = 0 guard"));
 }

@@ -573,15 +573,16 @@ fn sweep_of_the_lumped_hoffmann_finds_the_built_ins_coalescence() {
     assert!(d.path().join("a/sweep.csv").is_file());
 }
 
-/// A two-pad brake pressed hard with high friction reaches a state where
-/// a contact can neither stick nor slip on: the run ends at once with the
-/// time and the contact (exit 1, nothing written), rather than standing
-/// still until its step budget runs out and blaming stiffness.
+/// A two-pad brake pressed hard with high friction: a pad reaching
+/// `v_rel = 0` sticks. (Before, the sign of the round-off left by projecting
+/// the state onto `v_rel = 0` chose "slip on", the guard fired again at
+/// once, and the run stood still until its step budget ran out, blaming
+/// stiffness.)
 #[test]
-fn a_contact_that_can_neither_stick_nor_slip_on_is_named_at_once() {
+fn a_hard_pressed_two_pad_brake_sticks_and_slips_to_the_end() {
     let d = tempfile::tempdir().unwrap();
     let f = scenarios().join("two-pad-brake.toml");
-    let mut args = vec!["simulate", f.to_str().unwrap(), "--duration", "0.005"];
+    let mut args = vec!["simulate", f.to_str().unwrap(), "--duration", "0.02"];
     for s in [
         "pad1.V=0.05",
         "pad2.V=0.05",
@@ -592,14 +593,20 @@ fn a_contact_that_can_neither_stick_nor_slip_on_is_named_at_once() {
     ] {
         args.extend(["--set", s]);
     }
-    args.extend(["--out", "o"]);
-    let out = squeal(d.path(), &args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
+    args.extend(["--out", "o", "--no-plots"]);
+    let out = ok(&squeal(d.path(), &args));
+    assert!(out.contains("verdict: stick-slip"), "{out}");
+    let events = std::fs::read_to_string(d.path().join("o/events.csv")).unwrap();
+    let sticks = |pad: &str| {
+        events
+            .lines()
+            .filter(|l| l.ends_with(&format!("stick,{pad}")))
+            .count()
+    };
     assert!(
-        err.contains("no progress at t = 1.975540758e-4 s: contact pad1's v_rel = 0 guard fired 100 times in a row"),
-        "{err}"
+        sticks("pad1") > 100 && sticks("pad2") > 100,
+        "{} {}",
+        sticks("pad1"),
+        sticks("pad2")
     );
-    assert_eq!(err.trim().lines().count(), 1, "{err}");
-    assert!(!d.path().join("o").exists(), "nothing is written");
 }

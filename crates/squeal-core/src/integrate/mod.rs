@@ -99,14 +99,13 @@ pub enum IntegrateError {
         gap: f64,
     },
     /// A guard fires again and again at one instant without changing any
-    /// mode: the model decides that the contact goes on as it was, but its
-    /// motion crosses the guard at once (at `v_rel = 0`, neither sticking
-    /// nor slipping on in the direction the stick force gives is consistent
-    /// with the other contacts' forces). The run cannot go on.
+    /// mode: the model keeps the contact's mode, but the state it leaves
+    /// crosses the guard again at once (a model's transition that does not
+    /// move the state off its surface). The run cannot go on.
     #[error(
         "no progress at t = {t:.9e} s: contact {contact}'s {surface} guard fired {count} times in a row \
-         without changing its mode (stick is not admissible there, and slipping on in the \
-         direction the model chooses crosses the guard at once)"
+         without changing its mode (the model keeps the mode, but its motion crosses the guard again \
+         at once)"
     )]
     Stalled {
         /// Time (s).

@@ -1310,6 +1310,14 @@ impl Lumped {
     /// unilateral layer is open, else by the sign of v, and at `v = 0` stick
     /// if its multiplier (with it sticking) is within `μ_s F_n`.
     fn contact_mode(&self, t: f64, modes: &Modes, i: usize, z: &[f64]) -> Mode {
+        self.contact_mode_at(t, modes, i, z, false)
+    }
+
+    /// [`Self::contact_mode`]; with `at_rest`, the contact is known to be at
+    /// `v = 0` (just projected there), so the `v` recomputed from the state,
+    /// `V + t·q̇`, is round-off (≈ 1e-17 of cancelling terms) and its sign
+    /// must not choose a slip direction: the stick test decides.
+    fn contact_mode_at(&self, t: f64, modes: &Modes, i: usize, z: &[f64], at_rest: bool) -> Mode {
         let n = self.dofs.len();
         let (q, u) = z.split_at(n);
         let c = &self.contacts[i];
@@ -1321,7 +1329,7 @@ impl Lumped {
                 }
             }
         }
-        let v = c.sliding_velocity(u);
+        let v = if at_rest { 0.0 } else { c.sliding_velocity(u) };
         if v != 0.0 {
             return c.mode_for(v, 0.0, f_n);
         }
@@ -2087,7 +2095,7 @@ impl<const N: usize> System<N> for Lumped {
         let z = &*z;
         let (m, event) = contact::after_guard(g.kind, old, || {
             if g.kind == GuardKind::SlipZero {
-                let m = self.contact_mode(t, modes, i, &z[..]);
+                let m = self.contact_mode_at(t, modes, i, &z[..], true);
                 // Reached v = 0 without leaving the contact: stick or slip on.
                 if m == Mode::Free {
                     old
