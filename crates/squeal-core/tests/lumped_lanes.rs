@@ -3,86 +3,36 @@
 //! of lumped brakes bit for bit their single runs (stick–slip included).
 
 use squeal_core::integrate::ensemble::{simulate_ensemble_lanes, Job, LaneField, Lanes, LANES};
-use squeal_core::model::lumped::{ContactSpec, Fixed, ForceSpec, LumpedSpec, SpringSpec};
+use squeal_core::model::lumped::{self, Fixed, LumpedSpec, SpringSpec};
 use squeal_core::model::System;
 use squeal_core::sink::Recorder;
 use squeal_core::{simulate, EventKind, FrictionLaw, Lumped, Mode, Modes, SolverOptions};
 
-fn terms(t: &[(&str, f64)]) -> Vec<(String, f64)> {
-    t.iter().map(|(n, v)| (n.to_string(), *v)).collect()
-}
-
-fn spring(name: &str, on: &[(&str, f64)], k: f64, c: f64) -> SpringSpec {
-    SpringSpec {
-        name: name.into(),
-        on: terms(on),
-        k,
-        c,
-    }
-}
-
-fn force(name: &str, on: &[(&str, f64)], value: f64) -> ForceSpec {
-    ForceSpec {
-        name: name.into(),
-        on: terms(on),
-        value,
-        ramp: 0.0,
-    }
-}
-
-fn pad(name: &str, p: &str, sign: f64, bilateral: bool, alpha: f64) -> ContactSpec {
-    ContactSpec {
-        name: name.into(),
-        normal: Some(terms(&[("y_d", sign), (&format!("y_{p}"), -sign)])),
-        k: Some(4.25e9),
-        c: Some(0.2),
-        bilateral,
-        normal_force: None,
-        tangent: Some(terms(&[("x_d", 1.0), (&format!("x_{p}"), -1.0)])),
-        v: 1.0,
-        friction: FrictionLaw::Thesis {
+/// The two-pad brake of `scenarios/lumped/two-pad-brake.toml`
+/// (`lumped::two_pad_spec`) made to exercise every part of the lane-wise
+/// field: a spring coupling the disc's two directions (off-diagonal
+/// stiffness and damping), a follower force on the first pad, a bilateral
+/// layer on the second, stronger and velocity-weakening friction.
+fn two_pad_spec() -> LumpedSpec {
+    let mut spec = lumped::two_pad_spec();
+    spec.springs.push(SpringSpec {
+        name: "disc_xy".into(),
+        on: vec![("x_d".into(), 0.3), ("y_d".into(), 1.0)],
+        k: 1.0e6,
+        c: 0.5,
+    });
+    for c in &mut spec.contacts {
+        c.v = 1.0;
+        c.friction = FrictionLaw::Thesis {
             f0: 0.3,
             f1: 0.09,
             uc: 10.0,
-        },
-        alpha,
-        slope: terms(&[("y_d", 1.0)]),
+        };
     }
-}
-
-/// A disc between two pads (6 dofs): the first pad's contact unilateral
-/// with a follower force, the second bilateral without; a spring coupling
-/// the disc's two directions (off-diagonal stiffness and damping).
-fn two_pad_spec() -> LumpedSpec {
-    LumpedSpec {
-        dofs: ["x_d", "y_d", "x_p1", "y_p1", "x_p2", "y_p2"]
-            .map(String::from)
-            .to_vec(),
-        masses: terms(&[
-            ("x_d", 2.0),
-            ("y_d", 2.0),
-            ("x_p1", 0.1),
-            ("y_p1", 0.1),
-            ("x_p2", 0.1),
-            ("y_p2", 0.1),
-        ]),
-        springs: vec![
-            spring("disc_x", &[("x_d", 1.0)], 2.0e9, 2.0),
-            spring("disc_y", &[("y_d", 1.0)], 1.6e7, 2.0),
-            spring("disc_xy", &[("x_d", 0.3), ("y_d", 1.0)], 1.0e6, 0.5),
-            spring("pad1_x", &[("x_p1", 1.0)], 1.7e9, 0.2),
-            spring("pad2_x", &[("x_p2", 1.0)], 1.7e9, 0.2),
-        ],
-        forces: vec![
-            force("brake_1", &[("y_p1", 1.0)], -500.0),
-            force("brake_2", &[("y_p2", 1.0)], 500.0),
-        ],
-        contacts: vec![
-            pad("pad1", "p1", 1.0, false, 0.2),
-            pad("pad2", "p2", -1.0, true, 0.0),
-        ],
-        ..Default::default()
-    }
+    spec.contacts[0].alpha = 0.2;
+    spec.contacts[0].slope = vec![("y_d".into(), 1.0)];
+    spec.contacts[1].bilateral = true;
+    spec
 }
 
 /// Four (or [`LANES`]) brakes that differ in speed, friction and stiffness.

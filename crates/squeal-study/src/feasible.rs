@@ -231,9 +231,9 @@ pub fn series_bytes(sc: &Scenario) -> f64 {
 /// (`sc.solver.max_steps`). `what` names the run in messages.
 pub fn prepare(sc: &mut Scenario) -> Result<(), StudyError> {
     sc.validate()?;
-    let (rows, cols) = series_shape(sc);
     let bytes = series_bytes(sc);
     if bytes > MAX_SERIES_BYTES {
+        let (rows, cols) = series_shape(sc);
         return Err(InputError(format!(
             "sample_rate = {}: {} s at {} Hz is {rows:.3e} samples × {cols} columns = {:.2} GB in memory \
              (limit {:.2} GB); lower sample_rate or duration",

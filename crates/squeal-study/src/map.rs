@@ -356,10 +356,10 @@ fn transient_point<M: System<N>, const N: usize>(
 /// Transient map over `points` (flat indices, see [`point`]): one
 /// simulation per point, stopped early once its class is certain; one
 /// [`Outcome`] per point in the order given (`failed` where the point
-/// cannot run). The points go in tasks of 16, whose
-/// disc–pads and small lumped models run as an ensemble on one core (the
-/// same bits as one at a time). `progress` counts points; `cancel` is looked at before every task
-/// and ends the map with [`StudyError::Interrupted`].
+/// cannot run). The points go in tasks of 16, whose disc–pads and small
+/// lumped models run as an ensemble on one core (the same bits as one at a
+/// time). `progress` counts points; `cancel` is looked at before every
+/// task and ends the map with [`StudyError::Interrupted`].
 pub fn transient_grid(
     sc: &Scenario,
     x: &Axis,

@@ -65,6 +65,18 @@ fn linear_grid_points_are_the_same_bits_in_any_subset() {
     assert!(full.iter().any(|p| p.0 > 0.0) && full.iter().any(|p| p.0 < 0.0));
 }
 
+/// Two transient outcomes the same: the class, and every number to the bit.
+fn assert_same_outcome(what: &str, a: &map::Outcome, b: &map::Outcome) {
+    assert_eq!(a.class, b.class, "{what}");
+    for (x, y) in [
+        (a.rms, b.rms),
+        (a.t_end, b.t_end),
+        (a.stick_fraction, b.stick_fraction),
+    ] {
+        assert_eq!(x.to_bits(), y.to_bits(), "{what}: {x} vs {y}");
+    }
+}
+
 #[test]
 fn transient_grid_points_are_the_same_in_any_subset() {
     let sc = resolve_run(Source::Spec("disc-pad"), &[], Some(0.05)).unwrap();
@@ -74,11 +86,8 @@ fn transient_grid_points_are_the_same_in_any_subset() {
     let shard = [5, 0, 3];
     let part = map::transient_grid(&sc, &x, &y, &shard, &NoProgress, &Cancel::new()).unwrap();
     for (k, o) in shard.iter().zip(&part) {
-        let f = &full[*k];
-        assert_eq!(f.class, o.class, "point {k}");
-        assert_eq!(f.rms.to_bits(), o.rms.to_bits(), "point {k}");
-        assert_eq!(f.t_end.to_bits(), o.t_end.to_bits(), "point {k}");
-        assert_ne!(f.class, "failed", "point {k}");
+        assert_same_outcome(&format!("point {k}"), &full[*k], o);
+        assert_ne!(o.class, "failed", "point {k}");
     }
 }
 
@@ -98,15 +107,11 @@ fn transient_grid_equals_one_point_at_a_time() {
     let grid = map::transient_grid(&sc, &x, &y, &points, &NoProgress, &Cancel::new()).unwrap();
     assert_eq!(grid.len(), points.len());
     for (k, o) in points.iter().zip(&grid) {
-        let one = map::transient_at(&sc, &x, &y, *k);
-        assert_eq!(one.class, o.class, "point {k}");
-        for (a, b) in [
-            (one.rms, o.rms),
-            (one.t_end, o.t_end),
-            (one.stick_fraction, o.stick_fraction),
-        ] {
-            assert_eq!(a.to_bits(), b.to_bits(), "point {k}: {a} vs {b}");
-        }
+        assert_same_outcome(
+            &format!("point {k}"),
+            &map::transient_at(&sc, &x, &y, *k),
+            o,
+        );
     }
     let classes: std::collections::BTreeSet<&str> = grid.iter().map(|o| o.class).collect();
     assert!(
@@ -189,14 +194,7 @@ fn lumped_transient_grid_equals_one_point_at_a_time() {
         let grid = map::transient_grid(&sc, &x, &y, &points, &NoProgress, &Cancel::new()).unwrap();
         for (k, o) in points.iter().zip(&grid) {
             let one = map::transient_at(&sc, &x, &y, *k);
-            assert_eq!(one.class, o.class, "{file} point {k}");
-            for (a, b) in [
-                (one.rms, o.rms),
-                (one.t_end, o.t_end),
-                (one.stick_fraction, o.stick_fraction),
-            ] {
-                assert_eq!(a.to_bits(), b.to_bits(), "{file} point {k}: {a} vs {b}");
-            }
+            assert_same_outcome(&format!("{file} point {k}"), &one, o);
         }
         let classes: Vec<&str> = grid.iter().map(|o| o.class).collect();
         assert!(!classes.contains(&"failed"), "{file}: {classes:?}");

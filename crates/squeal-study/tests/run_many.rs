@@ -18,6 +18,15 @@ fn scenario(name: &str, sets: &[&str]) -> Scenario {
     sc
 }
 
+/// A disc–pad that cannot start: no steady sliding at V = 0 to take its
+/// equilibrium from (refused before it is integrated).
+fn unstartable() -> Scenario {
+    let mut sc = scenario("disc-pad", &["duration=0.01"]);
+    sc.model.set("V", 0.0).unwrap();
+    sc.initial = squeal_core::initial::Initial::Equilibrium;
+    sc
+}
+
 /// Both results identical: every column and statistic to the bit, the
 /// events and the error texts equal.
 fn assert_same(k: usize, a: &Result<Run, StudyError>, b: &Result<Run, StudyError>) {
@@ -76,10 +85,6 @@ fn run_many_is_run_on_each_scenario_bit_for_bit() {
     let mut budget = scenario("disc-pad", &["duration=0.05", "V=3"]);
     // A budget far too small: this run fails early while the others go on.
     budget.solver.max_steps = 300;
-    // No steady sliding to start from: refused before it is integrated.
-    let mut unstartable = scenario("disc-pad", &["duration=0.01"]);
-    unstartable.model.set("V", 0.0).unwrap();
-    unstartable.initial = squeal_core::initial::Initial::Equilibrium;
     let scs = vec![
         // The default run (it squeals from rest), long.
         scenario("disc-pad", &["duration=0.12"]),
@@ -96,7 +101,7 @@ fn run_many_is_run_on_each_scenario_bit_for_bit() {
         scenario("disc-pad", &["V=20", "N=800", "duration=0.015"]),
         scenario("two-pad-brake", &["duration=0.02"]),
         scenario("disc-pad", &["V=4", "N=1000", "duration=0.04"]),
-        unstartable,
+        unstartable(),
     ];
     let cancel = Cancel::new();
     let one: Vec<_> = scs.iter().map(|s| run(s, &NoProgress, &cancel)).collect();
@@ -134,13 +139,10 @@ fn run_many_is_run_on_each_scenario_bit_for_bit() {
 
 #[test]
 fn run_many_after_cancel_interrupts_every_scenario() {
-    // No steady sliding to start from: refused before it is integrated.
-    let mut unstartable = scenario("disc-pad", &["duration=0.01"]);
-    unstartable.model.set("V", 0.0).unwrap();
-    unstartable.initial = squeal_core::initial::Initial::Equilibrium;
     let scs = vec![
         scenario("disc-pad", &["duration=0.01"]),
         scenario("belt", &["duration=0.5"]),
+        unstartable(),
     ];
     let cancel = Cancel::new();
     cancel.cancel();

@@ -142,17 +142,18 @@ fn coulomb_belt_branch_over_v_is_exact() {
 #[test]
 fn belt_branch_from_slow_belt_settles_into_stick_slip() {
     let d = tempfile::tempdir().unwrap();
-    let out = squeal(
+    let j = json_of(&squeal(
         d.path(),
-        &["branch", "belt", "--param", "V=0.2:0.46:2", "--out", "b"],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = std::fs::read_to_string(d.path().join("b/summary.json")).unwrap();
-    let j: serde_json::Value = serde_json::from_str(&text).unwrap();
+        &[
+            "branch",
+            "belt",
+            "--param",
+            "V=0.2:0.46:2",
+            "--out",
+            "b",
+            "--json",
+        ],
+    ));
     assert_eq!(j["failed"].as_array().unwrap().len(), 0, "{}", j["failed"]);
     let points = j["points"].as_array().unwrap();
     assert_eq!(points.len(), 2);

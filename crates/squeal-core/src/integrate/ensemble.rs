@@ -448,60 +448,37 @@ impl<const N: usize> Soa<N> {
     ) {
         let mut y = [Lanes::ZERO; N];
         combine_lanes::<N, S>(&self.k, Some(&self.z), &A[S], self.h, &mut y);
-        Self::slopes(
-            &mut self.k[S],
-            &self.t,
-            self.h,
-            lanes,
-            batch,
-            S,
-            &y,
-            C[S],
-            f,
-        );
+        // The stage's times, as `Solver::stage`'s `t + c·h`.
+        let tc = Lanes::new(self.t) + Lanes::splat(C[S]) * self.h;
+        Self::slopes(&mut self.k[S], tc, lanes, batch, &y, f);
     }
 
-    /// `k[s] = f(t + c·h, y)` of the lanes of `batch` (anything
-    /// elsewhere): lane-wise by `f` where it can, by the lane's own model
-    /// where it declines. Not inlined: one copy of the right-hand side
+    /// `k_s = f(tc, y)` of the lanes of `batch` (anything elsewhere):
+    /// lane-wise by `f` where it can, by the lane's own model at its own
+    /// time where it declines. Not inlined: one copy of the right-hand side
     /// serves every stage, so the code stays within the instruction cache.
     #[inline(never)]
-    #[allow(clippy::too_many_arguments)]
     fn slopes<M: System<N> + ?Sized, F: Slopes<M, N>>(
         k_s: &mut [Lanes; N],
-        t: &[f64; L],
-        h: Lanes,
+        tc: Lanes,
         lanes: &[Option<Lane<'_, M, N>>; L],
         batch: &Batch<F::Masks>,
-        s: usize,
         y: &[Lanes; N],
-        c: f64,
         f: &F,
     ) {
         if batch.any {
-            // The lanes' times, lane-wise: the same sums as below.
-            let tl = Lanes::new(*t);
-            let tc = if s == 12 {
-                tl + h
-            } else {
-                tl + Lanes::splat(c) * h
-            };
             f.lanes(&batch.masks, tc, y, k_s);
         }
         let (modes, rest) = (&batch.modes, batch.rest);
         if !rest.contains(&true) {
             return;
         }
-        let h = h.to_array();
         let mut out = [[0.0; N]; L];
         for l in 0..L {
             if let (Some(lane), Some(m), true) = (&lanes[l], &modes[l], rest[l]) {
-                let tc = if s == 12 {
-                    t[l] + h[l]
-                } else {
-                    t[l] + c * h[l]
-                };
-                lane.solver.model.field(tc, m, &lane_of(y, l), &mut out[l]);
+                lane.solver
+                    .model
+                    .field(tc.lane(l), m, &lane_of(y, l), &mut out[l]);
             }
         }
         // The lanes evaluated one by one go in with one vector per state
@@ -580,11 +557,11 @@ impl<const N: usize> Soa<N> {
         self.stage::<M, F, 10>(lanes, &batch, fields);
         self.stage::<M, F, 11>(lanes, &batch, fields);
         combine_lanes::<N, 12>(&self.k, Some(&self.z), &B, self.h, &mut self.z_new);
-        let (k12, t, h) = (&mut self.k[12], &self.t, self.h);
-        Self::slopes(k12, t, h, lanes, &batch, 12, &self.z_new, 1.0, fields);
-        let one = Lanes::splat(1.0);
-        combine_lanes::<N, 13>(&self.k, None, &E5, one, &mut self.e5);
-        combine_lanes::<N, 13>(&self.k, None, &E3, one, &mut self.e3);
+        // The slope at the new state, at `t + h` as `Solver::rk_step`'s.
+        let tc = Lanes::new(self.t) + self.h;
+        Self::slopes(&mut self.k[12], tc, lanes, &batch, &self.z_new, fields);
+        combine_lanes::<N, 13>(&self.k, None, &E5, Lanes::ONE, &mut self.e5);
+        combine_lanes::<N, 13>(&self.k, None, &E3, Lanes::ONE, &mut self.e3);
         self.err = self.error_norms();
     }
 
@@ -628,11 +605,12 @@ impl<const N: usize> Soa<N> {
         self.stage::<M, F, 13>(lanes, &batch, f);
         self.stage::<M, F, 14>(lanes, &batch, f);
         self.stage::<M, F, 15>(lanes, &batch, f);
-        let d = &mut self.d;
-        combine_lanes::<N, 16>(&self.k, None, &D[0], self.h, &mut d[0]);
-        combine_lanes::<N, 16>(&self.k, None, &D[1], self.h, &mut d[1]);
-        combine_lanes::<N, 16>(&self.k, None, &D[2], self.h, &mut d[2]);
-        combine_lanes::<N, 16>(&self.k, None, &D[3], self.h, &mut d[3]);
+        // (Row by row with constant rows, so that their zeros vanish at
+        // compile time.)
+        combine_lanes::<N, 16>(&self.k, None, &D[0], self.h, &mut self.d[0]);
+        combine_lanes::<N, 16>(&self.k, None, &D[1], self.h, &mut self.d[1]);
+        combine_lanes::<N, 16>(&self.k, None, &D[2], self.h, &mut self.d[2]);
+        combine_lanes::<N, 16>(&self.k, None, &D[3], self.h, &mut self.d[3]);
         let d = &self.d;
         for (l, lane) in lanes.iter_mut().enumerate() {
             let (Some(lane), true) = (lane, accepted[l]) else {
@@ -648,9 +626,10 @@ impl<const N: usize> Soa<N> {
     }
 }
 
-/// [`super::combine`] for all lanes at once: `base + Σ_{j<J} (h·row[j])·k[j]`
-/// lane by lane, the terms in the same order, so each lane's sums are bit
-/// for bit those of a single run.
+/// [`super::combine`] for all lanes at once, into `y`:
+/// `base + Σ_{j<J} (h·row[j])·k[j]` lane by lane (`base` zero if `None`),
+/// the terms in the same order, so each lane's sums are bit for bit those
+/// of a single run.
 #[inline(always)]
 fn combine_lanes<const N: usize, const J: usize>(
     k: &[[Lanes; N]; 16],

@@ -49,6 +49,12 @@ impl Lanes {
         }))
     }
 
+    /// The mask (all bits set) of the lanes in `set`, for [`Self::blend`].
+    #[inline(always)]
+    pub fn mask(set: [bool; LANES]) -> Lanes {
+        Lanes::new(set.map(|b| if b { 1.0 } else { 0.0 })).cmp_gt(Lanes::ZERO)
+    }
+
     /// Every lane's number.
     #[inline(always)]
     pub fn to_array(self) -> [f64; LANES] {
@@ -175,6 +181,13 @@ mod tests {
             assert_eq!(pick, if x < y { x } else { y });
         }
         assert_eq!(Lanes::new(a).to_array(), a);
+        let set: [bool; LANES] = std::array::from_fn(|l| l % 3 == 1);
+        let picked = Lanes::mask(set).blend(va, vb).to_array();
+        assert_eq!(
+            picked,
+            std::array::from_fn(|l| if set[l] { a[l] } else { b[l] })
+        );
+        assert!(!Lanes::mask([false; LANES]).any());
         assert!(va.cmp_gt(Lanes::ZERO).any());
         assert!(!va.cmp_gt(Lanes::splat(10.0)).any());
         let nan = Lanes::splat(f64::NAN).max(Lanes::ONE);

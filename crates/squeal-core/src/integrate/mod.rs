@@ -477,9 +477,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 }
             }
             let Some(g) = fired else { return Ok(()) };
-            if matches!(g.kind, GuardKind::StickBreakPos | GuardKind::StickBreakNeg) {
-                broke |= 1 << g.contact;
-            }
+            broke |= stick_broken(&g);
             let mut z = self.z;
             let (next, ev) = self.model.switch(self.t, &modes, &g, &mut z);
             self.z = z;
@@ -913,11 +911,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 }
                 self.note_progress(t0, t1, next == modes && ev.is_none(), &g)?;
                 (self.pending_len, self.pending_next) = (0, 0);
-                let broke = match g.kind {
-                    GuardKind::StickBreakPos | GuardKind::StickBreakNeg => 1 << g.contact,
-                    _ => 0,
-                };
-                self.enter_mode(next, broke)?;
+                self.enter_mode(next, stick_broken(&g))?;
                 // A step cut short by an event: restart no larger than the part used.
                 self.h = self.h.min(h);
                 Ok(Segment {
@@ -1084,6 +1078,15 @@ fn power_basis(g0: f64, g: &[f64; 7]) -> [f64; 8] {
     }
     p[0] += g0;
     p
+}
+
+/// The bit of [`Solver::enter_mode`]'s `broke` that guard `g` sets when it
+/// fires: its contact's, if it is a stick-break guard.
+fn stick_broken<const N: usize>(g: &Guard<N>) -> u64 {
+    match g.kind {
+        GuardKind::StickBreakPos | GuardKind::StickBreakNeg => 1 << g.contact,
+        _ => 0,
+    }
 }
 
 /// Whether a guard in the nested form of [`power_basis`] is negative on the

@@ -637,28 +637,15 @@ impl LaneField<8> for DiscPad {
     }
 
     fn masks(modes: &[Option<Modes>; LANES]) -> (DiscPadMasks, [bool; LANES]) {
-        let mut neg = [0.0; LANES];
-        let mut stick = [0.0; LANES];
-        let mut free = [0.0; LANES];
-        let mut done = [false; LANES];
-        for (l, m) in modes.iter().enumerate() {
-            let Some(m) = m else { continue };
-            done[l] = true;
-            match m.first() {
-                Mode::SlipPos => {}
-                Mode::SlipNeg => neg[l] = 1.0,
-                Mode::Stick => stick[l] = 1.0,
-                Mode::Free => free[l] = 1.0,
-            }
-        }
-        let zero = Lanes::ZERO;
+        let first = modes.map(|m| m.map(|m| m.first()));
+        let lanes_in = |mode: Mode| Lanes::mask(first.map(|m| m == Some(mode)));
         let masks = DiscPadMasks {
-            any_stick: stick.contains(&1.0),
-            neg: Lanes::new(neg).cmp_gt(zero),
-            stick: Lanes::new(stick).cmp_gt(zero),
-            free: Lanes::new(free).cmp_gt(zero),
+            any_stick: first.contains(&Some(Mode::Stick)),
+            neg: lanes_in(Mode::SlipNeg),
+            stick: lanes_in(Mode::Stick),
+            free: lanes_in(Mode::Free),
         };
-        (masks, done)
+        (masks, modes.map(|m| m.is_some()))
     }
 
     // Every mode lane-wise: each lane's forces as `rhs` computes them in
@@ -684,7 +671,7 @@ impl LaneField<8> for DiscPad {
         let layer = p.k_py * (z[YD] - z[YP]) + p.c_py * (z[WD] - z[WP]);
         let v = p.v + z[UD] - z[UP];
         let sv = neg.blend(-v, v);
-        let one = Lanes::splat(1.0);
+        let one = Lanes::ONE;
         let mu = p.f0 * (one - p.f1 * sv * (one - sv / p.two_uc));
         let s_mu = neg.blend(-mu, mu);
         let mut f_t = s_mu * layer;

@@ -13,7 +13,7 @@
 //! stick is left to `field` (its friction forces are multipliers, solved
 //! for), as is every lane of models outside this (no pack).
 
-use super::{Fixed, FoldedContact, InvMass, Lumped, DENSE_FIELD_DOFS};
+use super::{DenseField, Fixed, FoldedContact, InvMass, Lumped, DENSE_FIELD_DOFS};
 use crate::friction::FrictionLaw;
 use crate::integrate::ensemble::{LaneField, Lanes, LANES};
 use crate::model::contact::Normal;
@@ -35,41 +35,32 @@ enum LaneLaw {
 impl LaneLaw {
     /// The law of every lane's contact, if all are of one lane-wise kind.
     fn of(laws: [FrictionLaw; LANES]) -> Option<LaneLaw> {
-        let get =
-            |f: &dyn Fn(&FrictionLaw) -> f64| Lanes::new(std::array::from_fn(|l| f(&laws[l])));
-        let all = |f: &dyn Fn(&FrictionLaw) -> bool| laws.iter().all(f);
-        Some(match laws[0] {
-            FrictionLaw::Thesis { .. } if all(&|x| matches!(x, FrictionLaw::Thesis { .. })) => {
-                let part = |l: &FrictionLaw| match *l {
-                    FrictionLaw::Thesis { f0, f1, uc } => (f0, f1, 2.0 * uc),
-                    _ => unreachable!("checked above"),
-                };
-                LaneLaw::Thesis {
-                    f0: get(&|l| part(l).0),
-                    f1: get(&|l| part(l).1),
-                    two_uc: get(&|l| part(l).2),
-                }
-            }
-            FrictionLaw::Coulomb { .. } if all(&|x| matches!(x, FrictionLaw::Coulomb { .. })) => {
-                LaneLaw::Coulomb {
-                    mu_k: get(&|l| match *l {
-                        FrictionLaw::Coulomb { mu_k, .. } => mu_k,
-                        _ => unreachable!("checked above"),
-                    }),
-                }
-            }
-            FrictionLaw::Rational { .. } if all(&|x| matches!(x, FrictionLaw::Rational { .. })) => {
-                let part = |l: &FrictionLaw| match *l {
-                    FrictionLaw::Rational { mu_s, delta } => (mu_s, delta),
-                    _ => unreachable!("checked above"),
-                };
-                LaneLaw::Rational {
-                    mu_s: get(&|l| part(l).0),
-                    delta: get(&|l| part(l).1),
-                }
-            }
-            _ => return None,
-        })
+        let kind = std::mem::discriminant(&laws[0]);
+        if laws.iter().any(|l| std::mem::discriminant(l) != kind) {
+            return None;
+        }
+        // Each lane's parameters, in the order of the variant's fields below.
+        let p = laws.map(|l| match l {
+            FrictionLaw::Thesis { f0, f1, uc } => [f0, f1, 2.0 * uc],
+            FrictionLaw::Coulomb { mu_k, .. } => [mu_k, 0.0, 0.0],
+            FrictionLaw::Rational { mu_s, delta } => [mu_s, delta, 0.0],
+            FrictionLaw::Stribeck { .. } => [0.0; 3],
+        });
+        let col = |j: usize| Lanes::new(std::array::from_fn(|l| p[l][j]));
+        match laws[0] {
+            FrictionLaw::Thesis { .. } => Some(LaneLaw::Thesis {
+                f0: col(0),
+                f1: col(1),
+                two_uc: col(2),
+            }),
+            FrictionLaw::Coulomb { .. } => Some(LaneLaw::Coulomb { mu_k: col(0) }),
+            FrictionLaw::Rational { .. } => Some(LaneLaw::Rational {
+                mu_s: col(0),
+                delta: col(1),
+            }),
+            // (exp and powf: not bit for bit lane-wise.)
+            FrictionLaw::Stribeck { .. } => None,
+        }
     }
 
     /// `μ(v)` lane by lane, as [`FrictionLaw::mu`].
@@ -126,54 +117,48 @@ pub struct LumpedMasks {
     slip: [Lanes; MAX_CONTACTS],
 }
 
+/// The folded operators of a model that [`LaneField::pack`] accepted.
+fn dense(m: &Lumped) -> &DenseField {
+    m.dense
+        .as_ref()
+        .expect("packed models have folded operators")
+}
+
 /// The lanes' rows `row(lane)` as one row of lane numbers.
-fn rows(models: &[&Lumped; LANES], row: &dyn Fn(&Lumped) -> [f64; D]) -> [Lanes; D] {
-    let r: [[f64; D]; LANES] = std::array::from_fn(|l| row(models[l]));
-    std::array::from_fn(|i| Lanes::new(std::array::from_fn(|l| r[l][i])))
+fn rows(models: &[&Lumped; LANES], row: &dyn Fn(&Lumped) -> &[f64; D]) -> [Lanes; D] {
+    std::array::from_fn(|i| Lanes::new(std::array::from_fn(|l| row(models[l])[i])))
 }
 
 /// The pack of one contact `ci` of every lane, if the lanes agree on its kind.
 fn contact_pack(models: &[&Lumped; LANES], ci: usize) -> Option<LaneContact> {
-    let c0 = &models[0].contacts[ci];
-    let kind = |m: &Lumped| match m.contacts[ci].normal {
-        Normal::Elastic { bilateral, .. } => Some(bilateral),
-        Normal::Prescribed(_) => None,
+    let contact = |l: usize| &models[l].contacts[ci];
+    // The normal force: a prescribed load, or a layer (bilateral or not).
+    let normal = |l: usize| match contact(l).normal {
+        Normal::Prescribed(f) => (Some(f), false),
+        Normal::Elastic { bilateral, .. } => (None, bilateral),
     };
-    if models.iter().any(|m| kind(m) != kind(models[0])) {
+    let (load, bilateral) = normal(0);
+    let kind = |l: usize| (normal(l).0.is_some(), normal(l).1);
+    if (1..LANES).any(|l| kind(l) != kind(0)) {
         return None;
     }
-    let law = LaneLaw::of(std::array::from_fn(|l| models[l].contacts[ci].friction))?;
-    let folded = |m: &Lumped| -> FoldedContact {
-        m.dense.as_ref().expect("checked by pack").contacts[ci].clone()
+    let law = LaneLaw::of(std::array::from_fn(|l| contact(l).friction))?;
+    let num = |f: &dyn Fn(usize) -> f64| Lanes::new(std::array::from_fn(f));
+    let alpha_on = Lanes::mask(std::array::from_fn(|l| contact(l).alpha != 0.0));
+    let folded = |row: fn(&FoldedContact) -> &[f64; D]| {
+        rows(models, &|m: &Lumped| row(&dense(m).contacts[ci]))
     };
-    let num = |f: &dyn Fn(&Lumped) -> f64| Lanes::new(std::array::from_fn(|l| f(models[l])));
-    let prescribed = match c0.normal {
-        Normal::Prescribed(_) => Some(num(&|m| match m.contacts[ci].normal {
-            Normal::Prescribed(f) => f,
-            Normal::Elastic { .. } => unreachable!("checked above"),
-        })),
-        Normal::Elastic { .. } => None,
-    };
-    let alpha = num(&|m| m.contacts[ci].alpha);
-    let alpha_on = num(&|m| {
-        if m.contacts[ci].alpha != 0.0 {
-            1.0
-        } else {
-            0.0
-        }
-    })
-    .cmp_gt(Lanes::ZERO);
     Some(LaneContact {
-        prescribed,
-        fn_q: rows(models, &|m| folded(m).fn_q),
-        fn_u: rows(models, &|m| folded(m).fn_u),
-        normal: rows(models, &|m| folded(m).normal),
-        tangent: rows(models, &|m| folded(m).tangent),
-        slope: rows(models, &|m| folded(m).slope),
-        bilateral: kind(models[0]) == Some(true),
-        v: num(&|m| m.contacts[ci].v),
+        prescribed: load.map(|_| num(&|l| normal(l).0.unwrap_or(0.0))),
+        fn_q: folded(|c| &c.fn_q),
+        fn_u: folded(|c| &c.fn_u),
+        normal: folded(|c| &c.normal),
+        tangent: folded(|c| &c.tangent),
+        slope: folded(|c| &c.slope),
+        bilateral,
+        v: num(&|l| contact(l).v),
         law,
-        alpha,
+        alpha: num(&|l| contact(l).alpha),
         alpha_on,
         any_alpha: alpha_on.any(),
     })
@@ -218,52 +203,39 @@ impl<const N: usize> LaneField<N> for Fixed<'_, N> {
         if !models.iter().all(|m| fits(m)) {
             return None;
         }
-        let dense = |l: usize| models[l].dense.as_ref().expect("checked above");
         // The off-diagonal entries in the same places in every lane.
-        let pattern = |l: usize| dense(l).off.iter().map(|&(r, c, _)| (r, c));
+        let pattern = |l: usize| dense(models[l]).off.iter().map(|&(r, c, _)| (r, c));
         if (1..LANES).any(|l| !pattern(l).eq(pattern(0))) {
             return None;
         }
-        let off = (0..dense(0).off.len())
-            .map(|k| {
-                let (r, c, _) = dense(0).off[k];
-                (r, c, Lanes::new(std::array::from_fn(|l| dense(l).off[k].2)))
-            })
+        let off = dense(models[0])
+            .off
+            .iter()
+            .enumerate()
+            .map(|(k, &(r, c, _))| (r, c, Lanes::new(models.map(|m| dense(m).off[k].2))))
             .collect();
         let contacts = (0..first.contacts.len())
             .map(|ci| contact_pack(&models, ci))
             .collect::<Option<Vec<_>>>()?;
-        let dense_of = |m: &Lumped| m.dense.as_ref().expect("checked above").clone();
         Some(LumpedLanes {
-            f0: rows(&models, &|m| dense_of(m).f0),
-            kd: rows(&models, &|m| dense_of(m).kd),
-            cd: rows(&models, &|m| dense_of(m).cd),
+            f0: rows(&models, &|m| &dense(m).f0),
+            kd: rows(&models, &|m| &dense(m).kd),
+            cd: rows(&models, &|m| &dense(m).cd),
             off,
-            inv_mass: rows(&models, &|m| dense_of(m).inv_mass),
+            inv_mass: rows(&models, &|m| &dense(m).inv_mass),
             contacts,
         })
     }
 
     fn masks(modes: &[Option<Modes>; LANES]) -> (LumpedMasks, [bool; LANES]) {
-        let mut neg = [[0.0; LANES]; MAX_CONTACTS];
-        let mut slip = [[0.0; LANES]; MAX_CONTACTS];
-        let mut done = [false; LANES];
-        for (l, m) in modes.iter().enumerate() {
-            let Some(m) = m else { continue };
-            done[l] = !m.as_slice().contains(&Mode::Stick);
-            for (ci, mode) in m.as_slice().iter().enumerate() {
-                match mode {
-                    Mode::SlipPos => slip[ci][l] = 1.0,
-                    Mode::SlipNeg => (slip[ci][l], neg[ci][l]) = (1.0, 1.0),
-                    Mode::Stick | Mode::Free => {}
-                }
-            }
-        }
-        let mask = |x: [f64; LANES]| Lanes::new(x).cmp_gt(Lanes::ZERO);
-        let masks = LumpedMasks {
-            neg: neg.map(mask),
-            slip: slip.map(mask),
+        let of = |ci: usize, pick: &dyn Fn(Mode) -> bool| {
+            Lanes::mask(modes.map(|m| m.is_some_and(|m| ci < m.len() && pick(m.get(ci)))))
         };
+        let masks = LumpedMasks {
+            neg: std::array::from_fn(|ci| of(ci, &|m| m == Mode::SlipNeg)),
+            slip: std::array::from_fn(|ci| of(ci, &|m| matches!(m, Mode::SlipPos | Mode::SlipNeg))),
+        };
+        let done = modes.map(|m| m.is_some_and(|m| !m.as_slice().contains(&Mode::Stick)));
         (masks, done)
     }
 
