@@ -1,6 +1,6 @@
 //! Audio rendering: anti-aliasing, length, level, looping, pitch.
 
-mod common;
+use crate::common;
 
 use common::tones;
 use squeal_signal::*;

@@ -1,6 +1,6 @@
 //! Growth-rate estimation from the Hilbert envelope.
 
-mod common;
+use crate::common;
 
 use common::exp_sine;
 use squeal_signal::*;

@@ -1,6 +1,6 @@
 //! Welch PSD, amplitude spectrum, peak picking and spectrogram.
 
-mod common;
+use crate::common;
 
 use common::{tones, variance, Lcg};
 use squeal_signal::*;

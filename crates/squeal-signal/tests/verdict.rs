@@ -1,6 +1,6 @@
 //! Run verdicts from synthetic velocity signals.
 
-mod common;
+use crate::common;
 
 use common::{exp_sine, tones, Lcg};
 use squeal_signal::*;

@@ -1,0 +1,19 @@
+//! The squeal-core integration tests as one binary (one link and one copy of the
+//! library's generic code instead of one per file: issue 24, class 9).
+//! Each file of this folder is a module; a new test file is declared here.
+
+mod branch;
+mod breakaway;
+mod budget;
+mod contact;
+mod cycle;
+mod engine;
+mod ensemble;
+mod equilibrium;
+mod lumped;
+mod lumped_lanes;
+mod modal;
+mod padding;
+mod projected;
+mod stability;
+mod sweep;

@@ -1,0 +1,14 @@
+//! The squeal integration tests as one binary (one link and one copy of the
+//! library's generic code instead of one per file: issue 24, class 9).
+//! Each file of this folder is a module; a new test file is declared here.
+
+mod cli;
+mod cycle_cli;
+mod lumped_cli;
+mod reliability;
+mod reproduce;
+mod shard_cli;
+mod signals;
+mod stability_cli;
+mod sweep_cli;
+mod verdict;
