@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
-# The real-SLURM test (called by .ci/run after `cargo test`): start MUNGE and
+# The real-SLURM test (called by .ci/run after `cargo test --release`): start MUNGE and
 # a single-node SLURM (slurmctld + slurmd, as root) under a temporary folder,
 # submit `squeal slurm map --submit`'s job array and its dependent merge job,
 # wait for them, and compare the merged map with the unsharded one byte for
 # byte. The daemons it started are stopped whatever happens (trap).
-# Uses the squeal that `cargo test` built (SQUEAL=… to choose another).
+# Uses the squeal that `cargo test --release` built (SQUEAL=… to choose another).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-SQUEAL=${SQUEAL:-${CARGO_TARGET_DIR:-$ROOT/target}/debug/squeal}
+SQUEAL=${SQUEAL:-${CARGO_TARGET_DIR:-$ROOT/target}/release/squeal}
 say() { echo "slurm-test: $*"; }
-[ -x "$SQUEAL" ] || { say "no squeal at $SQUEAL (run cargo test first)"; exit 1; }
+[ -x "$SQUEAL" ] || { say "no squeal at $SQUEAL (run cargo test --release first)"; exit 1; }
 [ "$(id -u)" = 0 ] || { say "must run as root (apt-get, SlurmUser=root)"; exit 1; }
 # shellcheck source=slurm-local.sh
 . "$ROOT/.ci/slurm-local.sh"
