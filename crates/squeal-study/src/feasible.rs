@@ -15,6 +15,40 @@ use squeal_core::System;
 /// Most bytes the sampled series of one run may take in memory (1 GiB).
 pub const MAX_SERIES_BYTES: f64 = 1024.0 * 1024.0 * 1024.0;
 
+/// Memory a run takes per byte of its series: the series, its CSV text
+/// and the analyses (spectra, envelope) made from it. Measured: `squeal
+/// simulate belt --set sample_rate=1e7 --duration 1` (0.48 GB of series)
+/// needs 1.3–1.4 GB of address space (`ulimit -v`), 5e6 Hz 0.8–0.9 GB:
+/// about 2.4 bytes per series byte above a fixed 0.2 GB; 3 leaves a margin.
+pub const RUN_MEMORY_PER_SERIES_BYTE: f64 = 3.0;
+
+/// Below this many bytes (64 MiB) no memory check is made: every machine
+/// squeal runs on has that, and a map of small runs reads no `/proc` files.
+pub const MEMORY_CHECK_FROM: f64 = 64.0 * 1024.0 * 1024.0;
+
+/// Memory of the dense analyses of a lumped model with `n` dofs (bytes):
+/// its steady-sliding Jacobian (`n × 2n`), the state matrix or the
+/// projection's dense eigenproblem, as `300 n²`. Measured: a 500-dof model
+/// peaks at 68 MB, a 1000-dof one at 277 MB (`/usr/bin/time -f %M squeal
+/// stability`), 272–277 bytes per n².
+pub fn dense_analysis_bytes(n: usize) -> f64 {
+    300.0 * (n as f64) * (n as f64)
+}
+
+/// Refuse a lumped model whose dense analyses would not fit the memory
+/// this process may take, before anything is sized from its dof count.
+pub fn check_model_memory(dofs: usize) -> Result<(), InputError> {
+    let need = dense_analysis_bytes(dofs);
+    if need > MEMORY_CHECK_FROM {
+        crate::memory::check(
+            need,
+            &format!("a lumped model of {dofs} dofs (its dense steady-sliding and eigen-analysis)"),
+        )
+        .map_err(InputError)?;
+    }
+    Ok(())
+}
+
 /// Most steps a run may need at the least (its [`min_steps`]): beyond this
 /// it would run for minutes (about 1 µs per step, and an accurate run takes
 /// ten times its bound), so it is refused before it starts. The default
@@ -244,6 +278,20 @@ pub fn prepare(sc: &mut Scenario) -> Result<(), StudyError> {
             MAX_SERIES_BYTES / 1e9
         ))
         .into());
+    }
+    let need = RUN_MEMORY_PER_SERIES_BYTE * bytes;
+    if need > MEMORY_CHECK_FROM {
+        crate::memory::check(
+            need,
+            &format!(
+                "sample_rate = {}: {} s at {} Hz ({:.2} GB of series, written as CSV and analysed)",
+                sc.sample_rate,
+                sc.duration,
+                sc.sample_rate,
+                bytes / 1e9
+            ),
+        )
+        .map_err(|m| InputError(format!("{m}; lower sample_rate or duration")))?;
     }
     let scales = scales(&sc.model, Some(sc)).map_err(|e| stability_failure(&sc.model, e))?;
     let lambda = scales.as_ref().map_or(0.0, |s| s.lambda_max);

@@ -6,6 +6,7 @@
 
 use crate::scenario::InputError;
 use squeal_core::model::contact::Normal;
+use squeal_core::model::lumped::MAX_MODEL_DOFS;
 use squeal_core::model::lumped::{ContactSpec, ForceSpec, LumpedSpec, SpringSpec, Terms, Triplets};
 use squeal_core::{FrictionLaw, Lumped};
 use std::fmt::Write as _;
@@ -118,14 +119,18 @@ pub fn parse(
                 ));
             };
             let path = base.map_or_else(|| PathBuf::from(p), |b| b.join(p));
-            let text = std::fs::read_to_string(&path).map_err(|e| {
-                InputError(format!(
-                    "matrices: {key} = '{p}': cannot read {}: {e}",
-                    path.display()
-                ))
-            })?;
+            let text = crate::input::read_regular_text(&path, crate::input::MAX_MATRIX_BYTES)
+                .map_err(|e| InputError(format!("matrices: {key} = '{p}': {e}")))?;
             let t: Triplets = squeal_core::matrix_market::parse(&text)
                 .map_err(|e| InputError(format!("matrices: {key} = '{p}': {e}")))?;
+            // The model's size limit, from the header, before anything is
+            // sized from it.
+            if t.rows.max(t.cols) > MAX_MODEL_DOFS {
+                return err(format!(
+                    "matrices: {key} = '{p}' is {}×{}: more than the {MAX_MODEL_DOFS} dofs a model may have",
+                    t.rows, t.cols
+                ));
+            }
             files.paths.push((key.clone(), p.clone()));
             match key.as_str() {
                 "M" => spec.m = Some(t),
@@ -145,14 +150,43 @@ pub fn parse(
         Some(other) => return err(format!("dofs = {other}: expected a list of names")),
         None => {
             // Numbered after the matrices: q1 … qn.
-            let n = [&spec.m, &spec.k, &spec.c]
+            let (nkey, n) = [("M", &spec.m), ("K", &spec.k), ("C", &spec.c)]
                 .iter()
-                .find_map(|t| t.as_ref().map(|t| t.rows))
+                .find_map(|(k, t)| t.as_ref().map(|t| (*k, t.rows)))
                 .ok_or_else(|| {
                     InputError(
                         "dofs: missing (a list of dof names, or [matrices] to number them)".into(),
                     )
                 })?;
+            // Every dof needs a mass (a positive-definite M has a positive
+            // diagonal): a header that claims more dofs than M's diagonal
+            // and [masses] can fill is refused before naming them.
+            let diagonal = spec.m.as_ref().map_or(0, |t| {
+                let mut d: Vec<usize> = t
+                    .entries
+                    .iter()
+                    .filter(|e| e.0 == e.1)
+                    .map(|e| e.0)
+                    .collect();
+                d.sort_unstable();
+                d.dedup();
+                d.len()
+            });
+            let listed = match table.get("masses") {
+                Some(toml::Value::Table(m)) => m.len(),
+                _ => 0,
+            };
+            if n > diagonal + listed {
+                let p = files
+                    .paths
+                    .iter()
+                    .find(|(k, _)| k == nkey)
+                    .map_or("", |(_, p)| p.as_str());
+                return err(format!(
+                    "matrices: {nkey} = '{p}' is {n}×{n}, but M's diagonal and [masses] give a mass to only {} dofs: every dof needs a mass",
+                    diagonal + listed
+                ));
+            }
             (1..=n).map(|i| format!("q{i}")).collect()
         }
     };

@@ -25,7 +25,7 @@ fn err<T>(msg: impl Into<String>) -> Result<T, InputError> {
 }
 
 /// Largest scenario file read (1 MiB).
-pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
+pub use crate::input::MAX_SCENARIO_BYTES;
 
 /// Most samples a run may write (guards memory against a typo in `sample_rate`).
 pub const MAX_SAMPLES: f64 = 5.0e7;
@@ -226,25 +226,16 @@ impl Scenario {
     /// A built-in name or a TOML file path.
     pub fn load(spec: &str) -> Result<Scenario, InputError> {
         let path = Path::new(spec);
-        if path.is_file() || spec.ends_with(".toml") {
-            // A scenario is a few kB; reading stops at 1 MiB (a device or a
-            // wrong file is not read for ever).
-            let mut text = String::new();
-            std::io::Read::read_to_string(
-                &mut std::io::Read::take(
-                    std::fs::File::open(path).map_err(|e| {
-                        InputError(format!("scenario file {spec}: cannot read: {e}"))
-                    })?,
-                    MAX_SCENARIO_BYTES + 1,
-                ),
-                &mut text,
+        if crate::input::names_a_non_folder(path) || spec.ends_with(".toml") {
+            // A scenario is a few kB: a regular file or a pipe (`<(…)`),
+            // at most 1 MiB, a silent pipe given up after 10 s; a device
+            // or folder is refused by name.
+            let text = crate::input::read_text_or_pipe(
+                path,
+                MAX_SCENARIO_BYTES,
+                crate::input::PIPE_TIMEOUT,
             )
-            .map_err(|e| InputError(format!("scenario file {spec}: cannot read: {e}")))?;
-            if text.len() as u64 > MAX_SCENARIO_BYTES {
-                return err(format!(
-                    "scenario file {spec}: larger than 1 MiB; not a scenario"
-                ));
-            }
+            .map_err(|e| InputError(format!("scenario file {spec}: {e}")))?;
             let mut sc = Scenario::from_toml_in(&text, path.parent())
                 .map_err(|e| InputError(format!("{spec}: {}", e.0)))?;
             // A file without a `name` is named after itself (out/<file stem>).
@@ -307,6 +298,7 @@ impl Scenario {
         let lumped = model_name == "lumped";
         let model = if lumped {
             let (l, files) = crate::lumped_file::parse(table, base)?;
+            crate::feasible::check_model_memory(l.dof_count())?;
             matrices = files;
             AnyModel::Lumped(Box::new(l))
         } else {

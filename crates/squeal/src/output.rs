@@ -3,6 +3,7 @@
 use crate::run::{Run, RunError};
 use serde_json::Value;
 use squeal_core::EventKind;
+use squeal_study::input::{read_regular, read_regular_text, MAX_RECORD_BYTES, MAX_TABLE_BYTES};
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
@@ -152,8 +153,8 @@ pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
         return Err(bad(format!("run folder {}: not a folder", dir.display())));
     }
     let summary_path = dir.join("summary.json");
-    let summary: Value = std::fs::read_to_string(&summary_path)
-        .map_err(|e| bad(format!("{}: cannot read: {e}", summary_path.display())))
+    let summary: Value = read_regular_text(&summary_path, MAX_RECORD_BYTES)
+        .map_err(bad)
         .and_then(|t| {
             serde_json::from_str(&t)
                 .map_err(|e| bad(format!("{}: malformed JSON: {e}", summary_path.display())))
@@ -174,9 +175,10 @@ pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
             }
         }
     }
-    let (columns, data) = if csv.is_file() {
-        let text = std::fs::read_to_string(&csv)
-            .map_err(|e| bad(format!("{}: cannot read: {e}", csv.display())))?;
+    // Anything by these names is read, so that a device or a pipe is
+    // refused by name rather than passed over.
+    let (columns, data) = if std::fs::symlink_metadata(&csv).is_ok() {
+        let text = read_regular_text(&csv, MAX_TABLE_BYTES).map_err(bad)?;
         let mut lines = text.lines();
         let header: Vec<String> = lines
             .next()
@@ -210,9 +212,8 @@ pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
             }
         }
         (header, data)
-    } else if npy.is_file() {
-        let bytes =
-            std::fs::read(&npy).map_err(|e| bad(format!("{}: cannot read: {e}", npy.display())))?;
+    } else if std::fs::symlink_metadata(&npy).is_ok() {
+        let bytes = read_regular(&npy, MAX_TABLE_BYTES).map_err(bad)?;
         let columns: Vec<String> = summary["columns"]
             .as_array()
             .map(|a| {
@@ -250,7 +251,13 @@ pub fn read_run_dir(dir: &Path) -> Result<(Run, Value), RunError> {
     let mut events = Vec::new();
     let mut event_contacts = Vec::new();
     let mut contact_names: Vec<String> = Vec::new();
-    if let Ok(text) = std::fs::read_to_string(dir.join("events.csv")) {
+    let events_path = dir.join("events.csv");
+    let events_text = if std::fs::symlink_metadata(&events_path).is_ok() {
+        Some(read_regular_text(&events_path, MAX_TABLE_BYTES).map_err(bad)?)
+    } else {
+        None
+    };
+    if let Some(text) = events_text {
         for line in text.lines().skip(1) {
             let mut cols = line.split(',');
             let (Some(t), Some(k)) = (cols.next(), cols.next()) else {

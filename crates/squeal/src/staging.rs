@@ -244,11 +244,12 @@ fn is_plain_relative(rel: &str) -> bool {
 /// if it has one that is not a valid squeal manifest.
 fn read_manifest(dir: &Path) -> Result<Option<Vec<String>>, String> {
     let path = dir.join(MANIFEST);
-    let text = match std::fs::read_to_string(&path) {
-        Ok(t) => t,
+    match std::fs::symlink_metadata(&path) {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(format!("cannot read {MANIFEST}: {e}")),
-    };
+        _ => {}
+    }
+    let text = squeal_study::input::read_regular_text(&path, squeal_study::input::MAX_RECORD_BYTES)
+        .map_err(|e| format!("{MANIFEST}: {e}"))?;
     let v: Value =
         serde_json::from_str(&text).map_err(|_| format!("{MANIFEST} is not a squeal manifest"))?;
     let files = v["files"]

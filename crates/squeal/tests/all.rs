@@ -6,6 +6,7 @@ mod cli;
 mod cycle_cli;
 mod lumped_cli;
 mod reliability;
+mod reliability_inputs;
 mod reproduce;
 mod shard_cli;
 mod signals;

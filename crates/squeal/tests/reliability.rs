@@ -609,14 +609,14 @@ fn messages_name_the_fix() {
     assert_refused(&o, 2, &["'n'", "did you mean 'N'"]);
     let o = squeal(d.path(), &["simulate", "--set", "zzz=2"]);
     assert_refused(&o, 2, &["'zzz'", "valid keys", "k_dx", "f0"]);
-    // Not a scenario: read no further than a scenario could be long.
+    // Not a scenario: a device is refused by name, not read (issue 24).
     std::os::unix::fs::symlink("/dev/zero", d.path().join("zero.toml")).unwrap();
     let o = ends_within(
         d.path(),
         &["simulate", "zero.toml"],
         Duration::from_secs(30),
     );
-    assert_refused(&o, 2, &["zero.toml", "not a scenario"]);
+    assert_refused(&o, 2, &["zero.toml", "is a character device"]);
     // μ = 0 is a friction coefficient; an invalid endpoint is named.
     let o = squeal(d.path(), &["critical", "hoffmann", "--param", "mu=0:1"]);
     assert!(o.status.success(), "{}", stderr(&o));

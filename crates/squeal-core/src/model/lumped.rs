@@ -441,20 +441,29 @@ impl Lumped {
         if n == 0 {
             return bad("dofs: the model needs at least one dof");
         }
+        if n > MAX_MODEL_DOFS {
+            return bad(format!(
+                "dofs: {n} dofs, more than the {MAX_MODEL_DOFS} a model may have"
+            ));
+        }
+        // Names to indices through a hash map: FE models have 10⁵–10⁶ dofs,
+        // where a linear search per name is quadratic.
+        let mut index: std::collections::HashMap<&str, usize> =
+            std::collections::HashMap::with_capacity(n);
         for (i, d) in spec.dofs.iter().enumerate() {
             if d.is_empty() || d.contains(['.', '=', ',', ' ']) {
                 return bad(format!(
                     "dofs: '{d}' is not a valid dof name (no '.', '=', ',' or spaces)"
                 ));
             }
-            if spec.dofs[..i].contains(d) {
+            if index.insert(d.as_str(), i).is_some() {
                 return bad(format!("dofs: '{d}' is listed twice"));
             }
         }
         let dof = |what: &str, key: &str, name: &str| -> Result<usize, SpecError> {
-            spec.dofs
-                .iter()
-                .position(|d| d == name)
+            index
+                .get(name)
+                .copied()
                 .ok_or_else(|| SpecError(format!("{what}: {key}: unknown dof '{name}'")))
         };
         let combo = |what: &str, key: &str, terms: &Terms| -> Result<Combination, SpecError> {
@@ -2206,6 +2215,11 @@ impl Lumped {
         a
     }
 }
+
+/// Most dofs a model may have (10⁶, an FE brake at full size): checked from
+/// a matrix file's header before anything is sized from it, and by
+/// [`Lumped::build`].
+pub const MAX_MODEL_DOFS: usize = 1_000_000;
 
 /// Most dofs a lumped model may have to be simulated: the integrator works on
 /// fixed-size state arrays, so each size is compiled in — every size up to

@@ -37,6 +37,7 @@ use crate::commands::map::{report, write_map, write_rows, Labels};
 use crate::run::{RunError, Staging};
 use clap::Args;
 use serde_json::{json, Value};
+use squeal_study::input::{read_regular, read_regular_text, MAX_RECORD_BYTES, MAX_TABLE_BYTES};
 use squeal_study::map::{Axis, Outcome, CLASSES};
 use squeal_study::scenario::InputError;
 use squeal_study::Scenario;
@@ -195,8 +196,7 @@ pub fn write_reproduce_part(
     let mut figures = Vec::new();
     for f in figure_files(stage.dir())? {
         let p = stage.dir().join(&f);
-        let b = std::fs::read(&p)
-            .map_err(|e| RunError::Io(format!("cannot read {}: {e}", p.display())))?;
+        let b = read_regular(&p, MAX_TABLE_BYTES).map_err(RunError::Io)?;
         figures.push(json!({ "file": f, "bytes": b.len(), "fnv1a": fnv1a(&b) }));
     }
     let doc = json!({
@@ -312,7 +312,7 @@ struct Read {
 fn read_manifest(dir: &Path) -> Result<Read, RunError> {
     let d = dir.display();
     let path = dir.join(SHARD_FILE);
-    let text = std::fs::read_to_string(&path).map_err(|e| {
+    let text = read_regular_text(&path, MAX_RECORD_BYTES).map_err(|e| {
         refuse(format!(
             "{d}: not a complete shard ({SHARD_FILE}: {e}); recompute it with its `squeal map … --shard K/N`"
         ))
@@ -420,7 +420,7 @@ fn read_part(
 ) -> Result<(), RunError> {
     let d = r.dir.display();
     let path = r.dir.join(PART_FILE);
-    let bytes = std::fs::read(&path)
+    let bytes = read_regular(&path, MAX_TABLE_BYTES)
         .map_err(|e| refuse(format!("{d}: not a complete shard ({PART_FILE}: {e})")))?;
     let part = &r.doc["part"];
     let want = Shard { k: r.k, n: r.n }.points(total);
@@ -648,7 +648,7 @@ fn checked_file(r: &Read, file: &str, entry: &Value) -> Result<Vec<u8>, RunError
             "{d}: {SHARD_FILE} names a file outside the shard: {file:?}"
         )));
     }
-    let bytes = std::fs::read(r.dir.join(file))
+    let bytes = read_regular(&r.dir.join(file), MAX_TABLE_BYTES)
         .map_err(|e| refuse(format!("{d}: not a complete shard ({file}: {e})")))?;
     if entry["bytes"].as_u64() != Some(bytes.len() as u64)
         || entry["fnv1a"].as_str() != Some(fnv1a(&bytes).as_str())
