@@ -449,3 +449,80 @@ fn disc_pad_branch_matches_settled_simulations() {
         assert_eq!(p.cycle.events_per_period[EventKind::Reverse.index()], 2);
     }
 }
+
+#[test]
+fn disc_pad_branch_reports_minimal_periods() {
+    // Issue 29: `branch disc-pad --param V=1:13:4` reported, at V = 5, 9
+    // and 13, four turns of the orbit (period 1.9276e-4 s, 8 reversals,
+    // the fourth power of the true multiplier). Every grid point's period
+    // must be the minimal one: the mean spacing of the pad velocity's
+    // upward zeros in a simulation settled as long as `cycle` needed
+    // (+ 50 %), to 1e-6, with two reversals per period.
+    let base = squeal_core::DiscPad::default();
+    let opts = BranchOptions::default();
+    let fam = squeal_core::cycle::continuation::Varied {
+        model: &base,
+        name: "V",
+    };
+    let copts = opts.cycle;
+    let mut settle = |v: f64| {
+        let mut m = base;
+        m.set("V", v).unwrap();
+        find_cycle(&m, 0.0, [0.0; 8], &copts)
+    };
+    let values = grid(1.0, 13.0, 4);
+    let b = branch(&fam, &values, &mut settle, &opts);
+    assert!(b.failures.is_empty(), "{:?}", b.failures);
+    let grid_points: Vec<_> = b
+        .points
+        .iter()
+        .filter(|p| matches!(p.kind, PointKind::Grid(_)))
+        .collect();
+    assert_eq!(grid_points.len(), 4);
+    for p in grid_points {
+        let mut m = base;
+        m.set("V", p.value).unwrap();
+        let t_settle = 1.5 * p.cycle.settle_time.max(b.points[0].cycle.settle_time);
+        let (t_sim, _) = disc_pad_settled(&m, t_settle, copts.solver);
+        assert!(
+            (p.cycle.period - t_sim).abs() <= 1e-6 * t_sim,
+            "V = {}: period {} vs settled {t_sim}",
+            p.value,
+            p.cycle.period
+        );
+        assert_eq!(
+            p.cycle.events_per_period[EventKind::Reverse.index()],
+            2,
+            "V = {}",
+            p.value
+        );
+    }
+}
+
+#[test]
+fn shooting_over_several_turns_returns_the_minimal_period() {
+    // Newton shooting started from k turns of a cycle converges on that
+    // k-turn orbit; it must report the orbit once, with multipliers
+    // computed over one turn (not the k-th power).
+    let mut m = squeal_core::DiscPad::default();
+    m.set("V", 5.0).unwrap();
+    let opts = CycleOptions::default();
+    let c = find_cycle(&m, 0.0, [0.0; 8], &opts).unwrap();
+    assert_eq!(c.events_per_period[EventKind::Reverse.index()], 2);
+    for k in [2.0, 3.0, 4.0] {
+        let again = squeal_core::cycle::shoot(&m, c.z0, k * c.period, c.section, &opts).unwrap();
+        assert!(
+            (again.period - c.period).abs() <= 1e-9 * c.period,
+            "{k} turns: period {} vs {}",
+            again.period,
+            c.period
+        );
+        assert!(
+            (again.max_multiplier - c.max_multiplier).abs() <= 1e-7,
+            "{k} turns: multiplier {} vs {}",
+            again.max_multiplier,
+            c.max_multiplier
+        );
+        assert_eq!(again.events_per_period, c.events_per_period);
+    }
+}

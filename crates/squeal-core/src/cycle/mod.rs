@@ -765,6 +765,9 @@ pub fn shoot<S: System<N> + ?Sized, const N: usize>(
         if residual <= opts.newton_tol
             || (iterations >= 3 && last_step <= 1e-12 && residual <= 1e3 * opts.newton_tol)
         {
+            if let Some(c) = minimal_period(sys, &z, t, section, &s, opts)? {
+                return Ok(c);
+            }
             return finish(sys, z, t, section, s, residual, iterations, p);
         }
         if iterations >= opts.newton_iterations {
@@ -805,6 +808,55 @@ pub fn shoot<S: System<N> + ?Sized, const N: usize>(
         if !last_step.is_finite() {
             return Err(CycleError::Shooting("Newton step not finite".into()));
         }
+    }
+}
+
+/// The scaled distance within which a state on a converged orbit counts
+/// as the orbit's starting state again (a return at a sub-period), and
+/// within which a re-shot orbit counts as the same orbit.
+fn same_state_tol(opts: &CycleOptions) -> f64 {
+    1e3 * opts.newton_tol
+}
+
+/// A periodic orbit's period is its minimal period. For an orbit `z` of
+/// converged period `t`, look for the largest `k ≤ max(max_returns, 2)`
+/// with `φ(t/k, z) = z` (scaled distance within [`same_state_tol`]), confirm
+/// it by shooting over `t/k` from `z`, and return that cycle (its
+/// multipliers computed over `t/k`, not as `k`-th roots) if it is the same
+/// orbit: the confirmed start must lie within the same tolerance of `z`,
+/// so that near a period doubling a genuine period-2 orbit (whose half
+/// period lands a finite distance away) is not merged into the period-1
+/// orbit. `None`: `t` is minimal.
+fn minimal_period<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    z: &[f64; N],
+    t: f64,
+    section: Section,
+    s: &[f64; N],
+    opts: &CycleOptions,
+) -> Result<Option<Cycle<N>>, CycleError> {
+    let kmax = opts.max_returns.max(2);
+    let tol = same_state_tol(opts);
+    let dist = |a: &[f64; N], b: &[f64; N]| {
+        (0..N)
+            .map(|i| ((a[i] - b[i]) / s[i]).abs())
+            .fold(0.0, f64::max)
+    };
+    let t_a = autonomous_from(sys);
+    let mut solver = Solver::new(sys, t_a, *z, t_a + 0.5 * t * (1.0 + 1e-9), opts.solver)?;
+    let mut best = None;
+    while let Some(seg) = solver.step()? {
+        for k in 2..=kmax {
+            let tk = t_a + t / k as f64;
+            if tk > seg.t0 && tk <= seg.t1 && dist(&solver.dense_at(tk), z) <= tol {
+                best = best.max(Some(k));
+            }
+        }
+    }
+    let Some(k) = best else { return Ok(None) };
+    match shoot(sys, *z, t / k as f64, section, opts) {
+        Ok(c) if dist(&c.z0, z) <= tol => Ok(Some(c)),
+        _ => Ok(None),
     }
 }
 
