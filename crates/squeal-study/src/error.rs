@@ -66,3 +66,60 @@ pub struct NoProgress;
 impl Progress for NoProgress {
     fn inc(&self, _n: u64) {}
 }
+
+/// Most characters of a message printed for a terminal (2000): keys and
+/// values echoed from the input are cut to fit (issue 24, class 6).
+pub const MAX_MESSAGE_CHARS: usize = 2000;
+
+/// A message as a terminal may show it: one line, control characters
+/// (newline, carriage return, ESC, …) and the Unicode controls that reorder
+/// or hide text (bidirectional overrides, zero-width marks, line and
+/// paragraph separators) escaped as `\n`, `\u{1b}`, …, and cut to
+/// [`MAX_MESSAGE_CHARS`] characters with the number left out said.
+pub fn for_terminal(msg: &str) -> String {
+    let hidden = |c: char| {
+        c.is_control()
+            || matches!(c, '\u{200b}'..='\u{200f}' | '\u{2028}'..='\u{202e}' | '\u{2066}'..='\u{2069}' | '\u{feff}')
+    };
+    let mut out = String::with_capacity(msg.len().min(MAX_MESSAGE_CHARS + 64));
+    for (shown, (i, c)) in msg.char_indices().enumerate() {
+        if shown >= MAX_MESSAGE_CHARS {
+            let rest = msg[i..].chars().count();
+            out.push_str(&format!("… ({rest} more characters)"));
+            break;
+        }
+        if hidden(c) {
+            match c {
+                '\n' => out.push_str("\\n"),
+                '\r' => out.push_str("\\r"),
+                '\t' => out.push_str("\\t"),
+                c => out.push_str(&format!("\\u{{{:x}}}", c as u32)),
+            }
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod terminal_tests {
+    use super::*;
+
+    #[test]
+    fn control_characters_are_escaped_and_long_lines_cut() {
+        assert_eq!(
+            for_terminal("key 'a\nb\x1b[31m' μ = 0.3"),
+            "key 'a\\nb\\u{1b}[31m' μ = 0.3"
+        );
+        assert_eq!(for_terminal("x\u{202e}y"), "x\\u{202e}y");
+        let long = "v".repeat(100_000);
+        let cut = for_terminal(&long);
+        assert!(cut.chars().count() < MAX_MESSAGE_CHARS + 40);
+        assert!(
+            cut.ends_with("… (98000 more characters)"),
+            "{}",
+            &cut[cut.len() - 40..]
+        );
+    }
+}

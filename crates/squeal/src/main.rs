@@ -74,7 +74,14 @@ fn main() -> ExitCode {
     // Before anything else runs: a build for x86-64-v3 (the default) on a
     // processor without AVX2 would otherwise die of an illegal instruction.
     if let Some(feature) = squeal_study::cpu::missing_feature() {
-        eprintln!("error: {}", squeal_study::cpu::refusal(feature));
+        // Plain bytes (nothing built for the missing feature runs here);
+        // a failed write to stderr is ignored.
+        use std::io::Write;
+        let _ = writeln!(
+            std::io::stderr(),
+            "error: {}",
+            squeal_study::cpu::refusal(feature)
+        );
         return ExitCode::from(1);
     }
     run_cli()
@@ -89,7 +96,41 @@ fn run_cli() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return usage_error(e),
     };
-    let result = match cli.command {
+    // A panic is a defect, never the user's fault: it ends as one line and
+    // exit code 1 (not Rust's 101 and a backtrace), with where it happened.
+    std::panic::set_hook(Box::new(|info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        let at = info
+            .location()
+            .map(|l| format!(" at {}:{}", l.file(), l.line()))
+            .unwrap_or_default();
+        crate::errln!("error: internal error{at}: {msg} (a defect of squeal: please report it with the command that caused it)");
+    }));
+    let run = std::panic::AssertUnwindSafe(move || dispatch(cli.command));
+    let result = match std::panic::catch_unwind(run) {
+        Ok(r) => r,
+        Err(_) => return ExitCode::from(1),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            crate::errln!("error: {e}");
+            match e {
+                RunError::Input(_) => ExitCode::from(2),
+                _ => ExitCode::from(1),
+            }
+        }
+    }
+}
+
+/// Run one command.
+fn dispatch(command: Command) -> Result<(), RunError> {
+    match command {
         Command::Simulate(a) => commands::simulate::run(a),
         Command::Scenario { what } => commands::scenario::run(what),
         Command::Plot(a) => commands::plot::run(a),
@@ -103,16 +144,6 @@ fn run_cli() -> ExitCode {
         Command::Listen(a) => commands::listen::run(a),
         Command::Cycle(a) => commands::cycle::run(a),
         Command::Branch(a) => commands::branch::run(a),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            match e {
-                RunError::Input(_) => ExitCode::from(2),
-                _ => ExitCode::from(1),
-            }
-        }
     }
 }
 
@@ -127,7 +158,7 @@ fn usage_error(e: clap::Error) -> ExitCode {
             | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
     ) {
         if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
-            eprint!("{}", e.render());
+            out::err_text(&e.render().to_string());
             return ExitCode::from(2);
         }
         out::text(&e.render().to_string());
@@ -151,8 +182,8 @@ fn usage_error(e: clap::Error) -> ExitCode {
         first = format!("{first} {}", listed.join(", "));
     }
     match lines.find(|l| l.starts_with("tip:")) {
-        Some(tip) => eprintln!("{first} ({tip}; see --help)"),
-        None => eprintln!("{first} (see --help)"),
+        Some(tip) => crate::errln!("{first} ({tip}; see --help)"),
+        None => crate::errln!("{first} (see --help)"),
     }
     ExitCode::from(2)
 }

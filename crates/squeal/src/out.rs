@@ -40,6 +40,32 @@ fn fail(e: std::io::Error) -> ! {
     if e.kind() == std::io::ErrorKind::BrokenPipe {
         std::process::exit(0);
     }
-    eprintln!("error: cannot write to standard output: {e}");
+    err_line(format_args!("error: cannot write to standard output: {e}"));
     std::process::exit(1);
+}
+
+/// `eprintln!` for standard error, through [`err_line()`]: never panics.
+#[macro_export]
+macro_rules! errln {
+    ($($t:tt)*) => {
+        $crate::out::err_line(format_args!($($t)*))
+    };
+}
+
+/// Write one line to standard error, as a terminal may show it
+/// ([`squeal_study::error::for_terminal`]: control characters escaped, cut
+/// to a sane length). A failed write (`2>/dev/full`, a closed stderr) is
+/// ignored: the run ends with its own exit code (issue 24, class 5).
+pub fn err_line(args: std::fmt::Arguments) {
+    let line = squeal_study::error::for_terminal(&args.to_string());
+    let mut e = std::io::stderr().lock();
+    let _ = e
+        .write_all(line.as_bytes())
+        .and_then(|_| e.write_all(b"\n"));
+}
+
+/// Text to standard error as it is (clap's help on a missing subcommand),
+/// ignoring a failed write.
+pub fn err_text(s: &str) {
+    let _ = std::io::stderr().lock().write_all(s.as_bytes());
 }

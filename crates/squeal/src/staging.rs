@@ -13,8 +13,14 @@
 //!   and swapped into place in one step (`renameat2(RENAME_EXCHANGE)` on
 //!   Linux; elsewhere two renames). Staging entries of processes that no
 //!   longer run are removed by the next run into the same parent folder.
-//! - SIGINT and SIGTERM remove the staging entries of the running process
-//!   and end it with 130 or 143.
+//! - A staging folder is made by exclusive creation (`mkdir` fails if the
+//!   name exists) and at once given a marker, [`STAGE_MARKER`], holding the
+//!   process id that made it. A stale staging folder is recognised by its
+//!   marker and that process being gone; a folder merely named like one
+//!   (no marker, another process id in it, or a live process) is never
+//!   deleted. A single file (`listen --out`) is staged inside such a folder.
+//! - SIGINT and SIGTERM remove the staging entries of the running process,
+//!   and the parent folders it created for them, and end it with 130 or 143.
 
 use crate::run::RunError;
 use serde_json::{json, Value};
@@ -28,11 +34,87 @@ pub const MANIFEST: &str = ".squeal-manifest.json";
 /// Prefix of staging entries (`.squeal-<pid>-<hash>.new|.old`).
 const STAGE_PREFIX: &str = ".squeal-";
 
-/// Staging entries of this process, removed by the signal handler.
-static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+/// The marker file inside a staging folder: `{"written_by": "squeal",
+/// "pid": …}`, written by the process that created the folder.
+pub const STAGE_MARKER: &str = ".squeal-staging.json";
 
-fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+/// A staging entry of this process and the parent folders created for it
+/// (outermost first), removed by the signal handler.
+struct Live {
+    tmp: PathBuf,
+    created: Vec<PathBuf>,
+}
+
+/// Staging entries of this process, removed by the signal handler.
+static LIVE: Mutex<Vec<Live>> = Mutex::new(Vec::new());
+
+fn live() -> std::sync::MutexGuard<'static, Vec<Live>> {
     LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Forget the live entry `tmp` (committed or removed).
+fn forget(live: &mut Vec<Live>, tmp: &Path) {
+    live.retain(|l| l.tmp != tmp);
+}
+
+/// Remove the folders in `created` (innermost first) that are empty.
+fn remove_created(created: &[PathBuf]) {
+    for d in created.iter().rev() {
+        let _ = std::fs::remove_dir(d);
+    }
+}
+
+/// The process id in a staging folder's marker, if it has a valid one.
+fn marker_pid(dir: &Path) -> Option<u32> {
+    let text = squeal_study::input::read_regular_text(&dir.join(STAGE_MARKER), 4096).ok()?;
+    let v: Value = serde_json::from_str(&text).ok()?;
+    if v["written_by"] != "squeal" {
+        return None;
+    }
+    v["pid"].as_u64().and_then(|p| u32::try_from(p).ok())
+}
+
+/// Create the staging folder `tmp` exclusively and mark it as this
+/// process's; `created` are the parent folders made for it. A folder
+/// already there is ours only if its marker names this process and it is
+/// not live (left by an earlier step of this run): it is then replaced;
+/// anything else by that name is refused, never deleted.
+fn make_stage(tmp: &Path, created: Vec<PathBuf>) -> Result<(), RunError> {
+    let cannot = |e: std::io::Error| {
+        RunError::Io(format!(
+            "cannot write into {}: {e}",
+            parent_of(tmp).display()
+        ))
+    };
+    let mut live = live();
+    match std::fs::create_dir(tmp) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+            let ours = std::fs::symlink_metadata(tmp).is_ok_and(|m| m.is_dir())
+                && marker_pid(tmp) == Some(std::process::id())
+                && !live.iter().any(|l| l.tmp == tmp);
+            if !ours {
+                remove_created(&created);
+                return Err(RunError::Io(format!(
+                    "cannot stage output: {} exists and was not made by this run of squeal; move it away",
+                    tmp.display()
+                )));
+            }
+            remove_partial(tmp);
+            std::fs::create_dir(tmp).map_err(cannot)?;
+        }
+        Err(e) => {
+            remove_created(&created);
+            return Err(cannot(e));
+        }
+    }
+    live.push(Live {
+        tmp: tmp.to_path_buf(),
+        created,
+    });
+    let marker = json!({ "written_by": "squeal", "pid": std::process::id() });
+    std::fs::write(tmp.join(STAGE_MARKER), format!("{marker}\n")).map_err(cannot)?;
+    Ok(())
 }
 
 /// Handle SIGINT and SIGTERM: remove this process's staging entries, then
@@ -46,14 +128,15 @@ pub fn install_signal_handlers() {
         if let Some(sig) = signals.forever().next() {
             // Holding the lock keeps a commit from starting meanwhile.
             let live = live();
-            for p in live.iter() {
-                remove_partial(p);
+            for l in live.iter() {
+                remove_partial(&l.tmp);
+                remove_created(&l.created);
             }
             let name = if sig == SIGINT { "SIGINT" } else { "SIGTERM" };
             if live.is_empty() {
-                eprintln!("interrupted ({name})");
+                crate::errln!("interrupted ({name})");
             } else {
-                eprintln!("interrupted ({name}): partial output removed");
+                crate::errln!("interrupted ({name}): partial output removed");
             }
             std::process::exit(128 + sig);
         }
@@ -136,7 +219,9 @@ pub fn clean_stale(dir: &Path) {
         let Some(pid) = name.to_str().and_then(stage_pid) else {
             continue;
         };
-        if pid != std::process::id() && !alive(pid) {
+        // Only folders: squeal stages everything in a marked folder, so a
+        // file by such a name is not squeal's.
+        if pid != std::process::id() && !alive(pid) && e.file_type().is_ok_and(|t| t.is_dir()) {
             remove_owned(&e.path());
         }
     }
@@ -157,11 +242,22 @@ fn remove_owned(p: &Path) {
     let files = match read_manifest(p) {
         Ok(Some(files)) => files,
         Ok(None) => {
-            remove_partial(p);
+            // No manifest: a staging folder not yet committed, removed
+            // whole only if its marker says squeal made it under the pid in
+            // its name; an empty folder goes too; anything else stays.
+            let name_pid = p.file_name().and_then(|n| n.to_str()).and_then(stage_pid);
+            if name_pid.is_some() && marker_pid(p) == name_pid {
+                remove_partial(p);
+            } else if std::fs::remove_dir(p).is_err() && p.exists() {
+                crate::errln!(
+                    "note: {} is named like a staging folder of squeal's but has no marker of it; left in place",
+                    p.display()
+                );
+            }
             return;
         }
         Err(e) => {
-            eprintln!("note: {} left in place: {e}", p.display());
+            crate::errln!("note: {} left in place: {e}", p.display());
             return;
         }
     };
@@ -180,7 +276,7 @@ fn remove_owned(p: &Path) {
         let _ = std::fs::remove_dir(d);
     }
     if std::fs::remove_dir(p).is_err() && p.exists() {
-        eprintln!(
+        crate::errln!(
             "note: {} holds files squeal did not write; it was left in place",
             p.display()
         );
@@ -292,6 +388,8 @@ fn refuse(flag: &str, p: &Path, why: impl std::fmt::Display) -> RunError {
 /// the current folder, a folder holding something squeal did not write — is
 /// refused, naming it.
 pub fn check_dest_as(flag: &str, dest: &Path) -> Result<(), RunError> {
+    // `link/` would make lstat follow the link: look at the name itself.
+    let dest = &without_trailing_slash(dest);
     let last = dest.components().next_back();
     if !matches!(last, Some(Component::Normal(_))) {
         return Err(refuse(
@@ -360,6 +458,27 @@ pub fn check_dest_as(flag: &str, dest: &Path) -> Result<(), RunError> {
     Ok(())
 }
 
+/// `p` without a trailing `/` (or `/.`), so that `symlink_metadata` looks
+/// at a link rather than through it.
+fn without_trailing_slash(p: &Path) -> PathBuf {
+    p.components().collect()
+}
+
+/// Refuse a folder squeal is to write into (`plot`'s run folder) that is
+/// itself a symbolic link; links among its ancestors (a linked scratch
+/// folder) are fine.
+pub fn check_not_a_link(what: &str, dir: &Path) -> Result<(), RunError> {
+    let dir = without_trailing_slash(dir);
+    match std::fs::symlink_metadata(&dir) {
+        Ok(m) if m.file_type().is_symlink() => Err(refuse(
+            what,
+            &dir,
+            "is a symbolic link; squeal does not write through links (name the folder itself)",
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Folders to create so that `dir` exists, outermost first.
 fn missing_ancestors(dir: &Path) -> Vec<PathBuf> {
     let mut missing = Vec::new();
@@ -407,6 +526,7 @@ impl Staging {
 
     /// [`Staging::new`] naming the flag that chose `dest` in messages.
     pub fn new_as(flag: &str, dest: &Path) -> Result<Staging, RunError> {
+        let dest = &without_trailing_slash(dest);
         check_dest_as(flag, dest)?;
         let parent = parent_of(dest);
         let created = missing_ancestors(parent);
@@ -414,20 +534,18 @@ impl Staging {
             tmp: stage_path(dest, "new"),
             dest: dest.to_path_buf(),
             flag: flag.to_string(),
-            created,
+            created: created.clone(),
             done: false,
         };
-        std::fs::create_dir_all(parent)
-            .map_err(|e| RunError::Io(format!("cannot create {}: {e}", parent.display())))?;
+        if let Err(e) = std::fs::create_dir_all(parent) {
+            remove_created(&created);
+            return Err(RunError::Io(format!(
+                "cannot create {}: {e}",
+                parent.display()
+            )));
+        }
         clean_stale(parent);
-        remove_partial(&s.tmp);
-        live().push(s.tmp.clone());
-        std::fs::create_dir(&s.tmp).map_err(|e| {
-            RunError::Io(format!(
-                "cannot write into {}: {e}",
-                parent_of(&s.dest).display()
-            ))
-        })?;
+        make_stage(&s.tmp, created)?;
         Ok(s)
     }
     /// A scratch folder beside `dir`, removed when dropped (never committed).
@@ -441,10 +559,7 @@ impl Staging {
             done: false,
         };
         clean_stale(parent);
-        remove_partial(&s.tmp);
-        live().push(s.tmp.clone());
-        std::fs::create_dir(&s.tmp)
-            .map_err(|e| RunError::Io(format!("cannot write into {}: {e}", parent.display())))?;
+        make_stage(&s.tmp, Vec::new())?;
         Ok(s)
     }
     /// Path of a file inside the staging folder.
@@ -458,6 +573,7 @@ impl Staging {
     /// Write the manifest and swap the complete output into place
     /// (replacing an older output of squeal's, which is then removed).
     pub fn commit(mut self) -> Result<PathBuf, RunError> {
+        let _ = std::fs::remove_file(self.tmp.join(STAGE_MARKER));
         write_manifest(&self.tmp)?;
         let mut live = live();
         // The destination may have changed while the work ran.
@@ -494,7 +610,7 @@ impl Staging {
                 remove_owned(&old);
             }
         }
-        live.retain(|p| p != &self.tmp);
+        forget(&mut live, &self.tmp);
         self.done = true;
         Ok(self.dest.clone())
     }
@@ -507,10 +623,8 @@ impl Drop for Staging {
         }
         let mut live = live();
         remove_partial(&self.tmp);
-        live.retain(|p| p != &self.tmp);
-        for d in self.created.iter().rev() {
-            let _ = std::fs::remove_dir(d);
-        }
+        forget(&mut live, &self.tmp);
+        remove_created(&self.created);
     }
 }
 
@@ -550,14 +664,19 @@ fn rename_noreplace(a: &Path, b: &Path) -> std::io::Result<()> {
 /// beside it and renamed into place by [`StagedFile::commit`]. An existing
 /// file is replaced only with `force`; folders and links never.
 pub struct StagedFile {
+    /// The marked staging folder beside `dest`.
+    dir: PathBuf,
+    /// The file written inside it.
     tmp: PathBuf,
     dest: PathBuf,
     force: bool,
+    created: Vec<PathBuf>,
     done: bool,
 }
 
 /// Check that squeal may write the single file `dest` (flag `flag`).
 pub fn check_file(flag: &str, dest: &Path, force: bool) -> Result<(), RunError> {
+    let dest = &without_trailing_slash(dest);
     if !matches!(dest.components().next_back(), Some(Component::Normal(_))) {
         return Err(refuse(flag, dest, "name a file"));
     }
@@ -570,6 +689,14 @@ pub fn check_file(flag: &str, dest: &Path, force: bool) -> Result<(), RunError> 
             "is a symbolic link; squeal does not write through links",
         )),
         Ok(m) if m.is_dir() => Err(refuse(flag, dest, "is a folder; name a file")),
+        Ok(m) if !m.is_file() => Err(refuse(
+            flag,
+            dest,
+            format!(
+                "is {}, not a regular file; squeal replaces only regular files, even with --force",
+                file_kind(&m)
+            ),
+        )),
         Ok(_) if force => Ok(()),
         Ok(_) => Err(refuse(
             flag,
@@ -584,20 +711,32 @@ impl StagedFile {
     pub fn new(flag: &str, dest: &Path, force: bool) -> Result<StagedFile, RunError> {
         check_file(flag, dest, force)?;
         let parent = parent_of(dest);
-        std::fs::create_dir_all(parent)
-            .map_err(|e| RunError::Io(format!("cannot create {}: {e}", parent.display())))?;
+        let created = missing_ancestors(parent);
+        if let Err(e) = std::fs::create_dir_all(parent) {
+            remove_created(&created);
+            return Err(RunError::Io(format!(
+                "cannot create {}: {e}",
+                parent.display()
+            )));
+        }
         clean_stale(parent);
-        let tmp = stage_path(dest, "new");
-        remove_partial(&tmp);
-        live().push(tmp.clone());
-        std::fs::File::create(&tmp)
-            .map_err(|e| RunError::Io(format!("cannot write into {}: {e}", parent.display())))?;
-        Ok(StagedFile {
+        let dir = stage_path(dest, "new");
+        make_stage(&dir, created.clone())?;
+        let tmp = dir.join(dest.file_name().unwrap_or(std::ffi::OsStr::new("file")));
+        let staged = StagedFile {
+            dir,
             tmp,
             dest: dest.to_path_buf(),
             force,
+            created,
             done: false,
-        })
+        };
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&staged.tmp)
+            .map_err(|e| RunError::Io(format!("cannot write into {}: {e}", parent.display())))?;
+        Ok(staged)
     }
     /// The temporary file to write.
     pub fn path(&self) -> &Path {
@@ -614,7 +753,8 @@ impl StagedFile {
         } else {
             rename_noreplace(&self.tmp, &self.dest).map_err(io)?;
         }
-        live.retain(|p| p != &self.tmp);
+        remove_partial(&self.dir);
+        forget(&mut live, &self.dir);
         self.done = true;
         Ok(self.dest.clone())
     }
@@ -624,9 +764,27 @@ impl Drop for StagedFile {
     fn drop(&mut self) {
         if !self.done {
             let mut live = live();
-            remove_partial(&self.tmp);
-            live.retain(|p| p != &self.tmp);
+            remove_partial(&self.dir);
+            forget(&mut live, &self.dir);
+            remove_created(&self.created);
         }
+    }
+}
+
+/// What a file system entry is, in words.
+fn file_kind(m: &std::fs::Metadata) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    let t = m.file_type();
+    if t.is_char_device() {
+        "a character device"
+    } else if t.is_block_device() {
+        "a block device"
+    } else if t.is_fifo() {
+        "a pipe (FIFO)"
+    } else if t.is_socket() {
+        "a socket"
+    } else {
+        "not a regular file"
     }
 }
 
@@ -634,6 +792,7 @@ impl Drop for StagedFile {
 /// `staged` holds the new files; each may replace only a file the folder's
 /// manifest lists (or none); the manifest then lists the new ones too.
 pub fn replace_files(dir: &Path, staged: &Path) -> Result<(), RunError> {
+    check_not_a_link("run folder", dir)?;
     let manifest = read_manifest(dir).map_err(|e| refuse("run folder", dir, e))?;
     let why = if manifest.is_some() {
         "which squeal did not write".to_string()
@@ -644,7 +803,7 @@ pub fn replace_files(dir: &Path, staged: &Path) -> Result<(), RunError> {
     let new: Vec<String> = walk(staged)
         .map_err(|e| RunError::Io(format!("cannot list {}: {e}", staged.display())))?
         .into_iter()
-        .filter(|e| !e.is_dir)
+        .filter(|e| !e.is_dir && e.rel != STAGE_MARKER)
         .map(|e| e.rel)
         .collect();
     for f in &new {
@@ -684,6 +843,13 @@ fn write_listed(dir: &Path, files: &[String]) -> Result<(), RunError> {
     let mut text = serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?;
     text.push('\n');
     let path = dir.join(MANIFEST);
+    if std::fs::symlink_metadata(&path).is_ok_and(|m| !m.is_file()) {
+        return Err(refuse(
+            "manifest",
+            &path,
+            "is not a regular file (a link?); squeal does not write through links",
+        ));
+    }
     std::fs::write(&path, text)
         .map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))
 }

@@ -266,6 +266,13 @@ fn stale_staging_of_a_dead_run_does_not_block_the_next() {
     // (with a manifest) of that dead run, beside the destination.
     let partial = d.path().join(format!(".squeal-{pid}-0123456789abcdef.new"));
     std::fs::create_dir(&partial).unwrap();
+    // squeal marks the staging folders it makes with its pid (issue 24:
+    // one without the marker is not squeal's and is never deleted).
+    std::fs::write(
+        partial.join(".squeal-staging.json"),
+        format!(r#"{{"written_by": "squeal", "pid": {pid}}}"#),
+    )
+    .unwrap();
     std::fs::write(partial.join("series.csv"), vec![b'1'; 1 << 20]).unwrap();
     let old = d.path().join(format!(".squeal-{pid}-0123456789abcdef.old"));
     std::fs::create_dir(&old).unwrap();

@@ -81,7 +81,7 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
     let clip = analysis::write_wav(x, run.sample_rate, staged.path(), a.float, &sound)?;
     staged.commit("--out")?;
     if clip.looped {
-        eprintln!(
+        crate::errln!(
             "note: the run ({:.3} s) is shorter than {:.1} s of sound: its last steady part is looped",
             clip.source_seconds,
             clip.duration()
@@ -111,7 +111,7 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
     );
     crate::outln!("{}", sound.describe(&clip));
     if let Some(note) = analysis::hearing_note(&judgement, &sound) {
-        eprintln!("{note}");
+        crate::errln!("{note}");
     }
     Ok(())
 }

@@ -20,6 +20,8 @@ pub struct PlotArgs {
 pub fn run(a: PlotArgs) -> Result<(), RunError> {
     let settings = a.spectrum.settings()?;
     let plot = a.spectrum.plot_settings()?;
+    // Checked before any work: plot writes into the run folder.
+    crate::staging::check_not_a_link("run folder", &a.run_dir)?;
     let (run, mut summary) = output::read_run_dir(&a.run_dir)?;
     analysis::check_signals(a.spectrum.signals(), &analysis::velocity_columns(&run))?;
     let model = summary["scenario"]["model"].as_str().unwrap_or("disc-pad");

@@ -155,13 +155,13 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
             let clip =
                 analysis::write_wav(x, run.sample_rate, &stage.path("squeal.wav"), false, &sound)?;
             if clip.looped {
-                eprintln!(
+                crate::errln!(
                     "note: the run ({:.3} s) is shorter than the 2 s of sound: its last steady part is looped",
                     clip.source_seconds
                 );
             }
             summary["audio"] = sound.json(&signal, &clip);
-            eprintln!("squeal.wav: {signal}, {}", sound.describe(&clip));
+            crate::errln!("squeal.wav: {signal}, {}", sound.describe(&clip));
             hearing = analysis::hearing_note(&an.judgement, &sound);
         }
     }
@@ -179,7 +179,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         print_human(&sc, &run, &summary, &dest);
     }
     if let Some(note) = hearing {
-        eprintln!("{note}");
+        crate::errln!("{note}");
     }
     Ok(())
 }
