@@ -8,6 +8,7 @@ mod lumped_cli;
 mod reliability;
 mod reliability_inputs;
 mod reliability_outputs;
+mod reliability_slurm;
 mod reproduce;
 mod shard_cli;
 mod signals;

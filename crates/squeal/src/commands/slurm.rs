@@ -109,14 +109,77 @@ fn abs(p: &Path) -> Result<PathBuf, RunError> {
     Ok(cwd.join(p))
 }
 
-/// A value for an `#SBATCH` line: one word.
-fn word(flag: &str, v: &Option<String>) -> Result<(), RunError> {
+/// Most CPUs a task may ask for: no node has more.
+pub const MAX_CPUS_PER_TASK: usize = 4096;
+
+/// A partition for the `#SBATCH` line: a name or a comma-separated list of
+/// names, of letters, digits, `_`, `-` and `.` (what SLURM's partition
+/// names are made of); anything else is refused, so nothing but the one
+/// directive reaches the script.
+fn partition(v: &Option<String>) -> Result<(), RunError> {
     match v {
-        Some(s) if s.is_empty() || s.chars().any(|c| c.is_whitespace() || c.is_control()) => {
-            Err(InputError(format!("{flag} {s:?}: must be one word without spaces")).into())
+        Some(s)
+            if s.is_empty()
+                || !s
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "_-.,".contains(c)) =>
+        {
+            Err(InputError(format!(
+                "--partition {s:?}: not a partition name (letters, digits, '_', '-', '.', comma-separated)"
+            ))
+            .into())
         }
         _ => Ok(()),
     }
+}
+
+/// A time limit in one of SLURM's formats (`MM`, `MM:SS`, `HH:MM:SS`,
+/// `D-HH`, `D-HH:MM`, `D-HH:MM:SS`, or `UNLIMITED`/`INFINITE`); anything
+/// else is refused.
+fn time_limit(v: &Option<String>) -> Result<(), RunError> {
+    let Some(s) = v else { return Ok(()) };
+    let numbers = |t: &str, most: usize| {
+        let parts: Vec<&str> = t.split(':').collect();
+        parts.len() <= most
+            && parts
+                .iter()
+                .all(|p| !p.is_empty() && p.len() <= 9 && p.chars().all(|c| c.is_ascii_digit()))
+    };
+    let ok = matches!(s.to_ascii_lowercase().as_str(), "unlimited" | "infinite")
+        || match s.split_once('-') {
+            Some((days, rest)) => numbers(days, 1) && numbers(rest, 3),
+            None => numbers(s, 3),
+        };
+    if ok {
+        Ok(())
+    } else {
+        Err(InputError(format!(
+            "--time {s:?}: not a SLURM time limit (MM, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS or UNLIMITED)"
+        ))
+        .into())
+    }
+}
+
+/// A path for an `#SBATCH` line. SLURM reads those lines itself, one line
+/// each, not through a shell: a control character (a newline would start a
+/// new directive or a command), a quote or a backslash (which its option
+/// parser interprets) is refused, naming what supplied the path; the
+/// path is then single-quoted (it may hold spaces). With a `file` (a log
+/// file name, which may use SLURM's patterns such as `%a`), the path is a
+/// folder whose own `%` are escaped as `%%` and `file` is joined to it.
+fn sbatch_path(what: &str, p: &Path, file: Option<&str>) -> Result<String, RunError> {
+    let s = p.to_string_lossy();
+    if let Some(c) = s.chars().find(|c| c.is_control() || "'\"\\".contains(*c)) {
+        return Err(InputError(format!(
+            "{what} {}: holds {c:?}, which a SLURM script's #SBATCH line cannot carry; choose a folder without it",
+            s.escape_debug()
+        ))
+        .into());
+    }
+    Ok(match file {
+        Some(f) => format!("'{}/{f}'", s.replace('%', "%%")),
+        None => format!("'{s}'"),
+    })
 }
 
 /// The `squeal map …` arguments that fix the study (not --out, --shard).
@@ -195,6 +258,7 @@ pub fn run(cmd: SlurmCmd) -> Result<(), RunError> {
             check_job(&a.job, a.map.shard.is_some(), "map")?;
             let (sc, x, y) = prepare(&a.map)?;
             let points = x.values.len() * y.values.len();
+            check_tasks(a.job.tasks, points, "points of the map")?;
             let out = a
                 .map
                 .out
@@ -207,6 +271,7 @@ pub fn run(cmd: SlurmCmd) -> Result<(), RunError> {
         SlurmCmd::Reproduce(a) => {
             check_job(&a.job, a.rep.shard.is_some(), "reproduce")?;
             let sets = squeal_study::reproduce::prepared_sets(a.rep.duration_scale)?;
+            check_tasks(a.job.tasks, sets.len(), "sets of the thesis")?;
             let out = a
                 .rep
                 .out
@@ -261,8 +326,26 @@ fn check_job(job: &JobArgs, shard: bool, cmd: &str) -> Result<(), RunError> {
     if job.cpus_per_task == Some(0) {
         return Err(InputError("--cpus-per-task 0: need at least 1 CPU".into()).into());
     }
-    word("--partition", &job.partition)?;
-    word("--time", &job.time)
+    if let Some(c) = job.cpus_per_task.filter(|c| *c > MAX_CPUS_PER_TASK) {
+        return Err(InputError(format!(
+            "--cpus-per-task {c}: more than the {MAX_CPUS_PER_TASK} CPUs any node has"
+        ))
+        .into());
+    }
+    partition(&job.partition)?;
+    time_limit(&job.time)
+}
+
+/// `--tasks` above the number of shards there are to compute is refused,
+/// naming the bound.
+fn check_tasks(tasks: usize, units: usize, what: &str) -> Result<(), RunError> {
+    if tasks > units {
+        return Err(InputError(format!(
+            "--tasks {tasks}: more tasks than the {units} {what}"
+        ))
+        .into());
+    }
+    Ok(())
 }
 
 /// Write (and with `--submit` submit) `array.sh` and `merge.sh` for the
@@ -287,7 +370,8 @@ fn scripts(
     } else {
         "jobs folder (default --jobs)"
     };
-    let stage = Staging::new_as(flag, &jobs)?;
+    // Checked before any work (nothing is written if it would fail).
+    crate::staging::check_dest_as(flag, &jobs)?;
     let exe = std::env::current_exe()
         .map_err(|e| RunError::Io(format!("cannot find the squeal executable: {e}")))?;
     let cwd = std::env::current_dir()
@@ -295,7 +379,10 @@ fn scripts(
     let p = |p: &Path| sh(&p.to_string_lossy());
     let n = a.tasks;
     let mut head = String::from("#!/bin/bash\n");
-    let mut common = format!("#SBATCH --chdir={}\n", p(&cwd));
+    let mut common = format!(
+        "#SBATCH --chdir={}\n",
+        sbatch_path("the current folder", &cwd, None)?
+    );
     if let Some(part) = &a.partition {
         common.push_str(&format!("#SBATCH --partition={part}\n"));
     }
@@ -317,7 +404,7 @@ fn scripts(
     }
     array.push_str(&format!(
         "#SBATCH --output={}\n{common}",
-        p(&jobs.join("shard-%a.log"))
+        sbatch_path(flag, &jobs, Some("shard-%a.log"))?
     ));
     array.push_str(&format!(
         "set -euo pipefail\n# squeal's threads: the task's CPUs\nexport RAYON_NUM_THREADS=\"${{SLURM_CPUS_PER_TASK:-1}}\"\n\
@@ -330,7 +417,7 @@ fn scripts(
     let mut merge = head;
     merge.push_str(&format!(
         "#SBATCH --job-name=squeal-merge\n#SBATCH --output={}\n{common}",
-        p(&jobs.join("merge.log"))
+        sbatch_path(flag, &jobs, Some("merge.log"))?
     ));
     merge.push_str(&format!(
         "set -euo pipefail\nexec {} merge {}/shard-{{0..{}}}/{cmd} --out {}\n",
@@ -339,6 +426,7 @@ fn scripts(
         n - 1,
         p(&out)
     ));
+    let stage = Staging::new_as(flag, &jobs)?;
     for (name, text) in [("array.sh", &array), ("merge.sh", &merge)] {
         let path = stage.path(name);
         std::fs::write(&path, text)
