@@ -65,6 +65,18 @@ impl ParamSpec {
     }
 }
 
+/// A number as a message shows it: as written (`2000`, `0.1`) unless that
+/// takes more than 12 characters, then in exponent form (`1e300`, not 301
+/// digits).
+pub fn short(v: f64) -> String {
+    let plain = format!("{v}");
+    if plain.len() <= 12 {
+        plain
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// A bad parameter: every variant names the key and the value.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum ParamError {
@@ -75,7 +87,7 @@ pub enum ParamError {
         key: String,
     },
     /// The value is out of the parameter's range.
-    #[error("{key} = {value}: {why}")]
+    #[error("{key} = {}: {why}", short(*value))]
     Invalid {
         /// The key.
         key: String,
@@ -85,7 +97,7 @@ pub enum ParamError {
         why: String,
     },
     /// The value contradicts another parameter.
-    #[error("{key} = {value}: {why}")]
+    #[error("{key} = {}: {why}", short(*value))]
     Relation {
         /// The key.
         key: String,

@@ -282,8 +282,12 @@ pub struct BranchPoint {
     pub segment: usize,
 }
 
+/// Most grid values of a branch (each one a limit cycle found by
+/// continuation: up to seconds of work; 10 000 is hours at most).
+pub const MAX_BRANCH_POINTS: usize = 10_000;
+
 /// Parse `NAME=LO:HI:N` (`squeal branch --param`): N evenly spaced
-/// values of NAME from LO to HI, LO < HI finite, 2 ≤ N ≤ 100 000.
+/// values of NAME from LO to HI, LO < HI finite, 2 ≤ N ≤ [`MAX_BRANCH_POINTS`].
 pub fn parse_range(spec: &str) -> Result<(String, f64, f64, usize), InputError> {
     let bad = || {
         InputError(format!(
@@ -298,8 +302,13 @@ pub fn parse_range(spec: &str) -> Result<(String, f64, f64, usize), InputError> 
     let lo: f64 = parts[0].trim().parse().map_err(|_| bad())?;
     let hi: f64 = parts[1].trim().parse().map_err(|_| bad())?;
     let n: usize = parts[2].trim().parse().map_err(|_| bad())?;
-    if !(lo.is_finite() && hi.is_finite() && lo < hi && (2..=100_000).contains(&n)) {
+    if !(lo.is_finite() && hi.is_finite() && lo < hi) {
         return Err(bad());
+    }
+    if !(2..=MAX_BRANCH_POINTS).contains(&n) {
+        return Err(InputError(format!(
+            "--param {spec}: N = {n}: a branch has from 2 to {MAX_BRANCH_POINTS} grid values (each is a limit cycle: seconds of work)"
+        )));
     }
     Ok((name.trim().to_string(), lo, hi, n))
 }

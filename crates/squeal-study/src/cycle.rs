@@ -55,6 +55,15 @@ pub fn options(sc: &Scenario, settle_steps: u64, settle_time: f64) -> CycleOptio
     }
 }
 
+/// Most integrator steps one settling run may take (`--settle-steps`):
+/// 1e9, about an hour of the disc–pad model; `find_cycle` settles at most
+/// seven times, so a cycle's work is bounded by the request.
+pub const MAX_SETTLE_STEPS: u64 = 1_000_000_000;
+
+/// Finest `--settle-tol`: returns to the section agree no better than the
+/// integrator's tolerance (1e-10) lets them.
+pub const MIN_SETTLE_TOL: f64 = 1e-9;
+
 /// The options of `squeal cycle` after its checks (the CLI and the Python
 /// bindings call this one function): the settling budget (`settle_steps`
 /// returns, at most `settle_time` s simulated, agreement `settle_tol` in
@@ -76,8 +85,20 @@ pub fn checked_options(
     if !(settle_tol > 0.0 && settle_tol < 1.0) {
         return Err(InputError(format!("--settle-tol {settle_tol}: must be in (0, 1)")).into());
     }
+    if settle_tol < MIN_SETTLE_TOL {
+        return Err(InputError(format!(
+            "--settle-tol {settle_tol:e}: below {MIN_SETTLE_TOL:e}, finer than the integrator resolves: returns would never agree, and settling would spend its whole budget"
+        ))
+        .into());
+    }
     if settle_steps == 0 {
         return Err(InputError("--settle-steps 0: must be at least 1".into()).into());
+    }
+    if settle_steps > MAX_SETTLE_STEPS {
+        return Err(InputError(format!(
+            "--settle-steps {settle_steps}: more than the {MAX_SETTLE_STEPS} steps a settling run may take (about an hour at 0.4 million steps per second; with a few settling attempts per cycle)"
+        ))
+        .into());
     }
     sc.model.check_cycle_size().map_err(InputError)?;
     // The validation path of a simulated run, the part that applies to a

@@ -7,6 +7,7 @@ mod cycle_cli;
 mod lumped_cli;
 mod reliability;
 mod reliability_inputs;
+mod reliability_limits;
 mod reliability_outputs;
 mod reliability_slurm;
 mod reproduce;

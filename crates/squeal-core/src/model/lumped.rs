@@ -493,9 +493,12 @@ impl Lumped {
                     spec.dofs.join(", ")
                 ))
             })?;
-            if !(m.is_finite() && *m > 0.0) {
+            if !mass_ok(*m) {
                 return bad(format!(
-                    "masses: {name} = {m}: a mass must be a finite number > 0 (kg)"
+                    "masses: {name} = {}: a mass must be a number from {:e} to {:e} (kg)",
+                    crate::params::short(*m),
+                    MASS_RANGE.0,
+                    MASS_RANGE.1
                 ));
             }
             masses[i] = *m;
@@ -806,6 +809,9 @@ impl Lumped {
                 }
                 if i == j {
                     if s <= 1e-10 * self.gram[i][i] {
+                        if let Some(msg) = self.dependence_from_masses(i) {
+                            return bad(msg);
+                        }
                         let others: Vec<String> = (0..i)
                             .filter(|&k| {
                                 self.gram[i][k].abs()
@@ -813,10 +819,16 @@ impl Lumped {
                             })
                             .map(|k| format!("'{}'", self.contacts[k].name))
                             .collect();
+                        if others.is_empty() {
+                            return bad(format!(
+                                "contact '{}': tangent: moves no mass (t·M⁻¹·t = {:e}): its stick force is not determined",
+                                self.contacts[i].name, self.gram[i][i]
+                            ));
+                        }
                         return bad(format!(
                             "contact '{}': tangent: its stick constraint is redundant with {} (the tangents are linearly dependent, so the stick forces are not determined)",
                             self.contacts[i].name,
-                            if others.is_empty() { "the other contacts'".to_string() } else { others.join(" and ") }
+                            others.join(" and ")
                         ));
                     }
                     l[i][i] = s.sqrt();
@@ -831,6 +843,50 @@ impl Lumped {
 
     /// Rebuild the folded operators of the right-hand side ([`DenseField`])
     /// from the elements (small models only).
+    /// When the stick constraints up to contact `i` are dependent in the
+    /// metric `M⁻¹` but their tangents are independent as vectors (the
+    /// same Cholesky test with unit masses passes), the masses are the
+    /// cause: a message naming the largest mass on contact `i`'s tangent
+    /// against the smallest of the model.
+    fn dependence_from_masses(&self, i: usize) -> Option<String> {
+        let n = self.dofs.len();
+        let dense: Vec<Vec<f64>> = (0..=i).map(|k| self.contacts[k].tangent.dense(n)).collect();
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let mut l = vec![vec![0.0; i + 1]; i + 1];
+        for a in 0..=i {
+            for b in 0..=a {
+                let mut s = dot(&dense[a], &dense[b]);
+                for k in 0..b {
+                    s -= l[a][k] * l[b][k];
+                }
+                if a == b {
+                    if s <= 1e-10 * dot(&dense[a], &dense[a]) {
+                        return None; // dependent as vectors: truly redundant
+                    }
+                    l[a][a] = s.sqrt();
+                } else {
+                    l[a][b] = s / l[b][b];
+                }
+            }
+        }
+        let masses = self.diagonal_masses();
+        let (heavy, m_heavy) = self.contacts[i]
+            .tangent
+            .idx
+            .iter()
+            .map(|&d| (d, masses[d]))
+            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        let (light, m_light) = masses
+            .iter()
+            .copied()
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        Some(format!(
+            "mass.{} = {m_heavy:e}: a bad mass: beside mass.{} = {m_light:e} it leaves contact '{}''s tangent no motion double precision can resolve, so its stick force is not determined (the tangents themselves are independent); keep the masses within a factor 1e12 of each other",
+            self.dofs[heavy], self.dofs[light], self.contacts[i].name
+        ))
+    }
+
     fn rebuild_dense(&mut self) {
         let n = self.dofs.len();
         if n > DENSE_FIELD_DOFS {
@@ -1704,8 +1760,10 @@ impl Lumped {
         let mut refresh = false;
         if el == "mass" {
             let i = self.dofs.iter().position(|d| d == k).ok_or_else(unknown)?;
-            if !(value.is_finite() && value > 0.0) {
-                return Err(invalid("a mass must be a finite number > 0 (kg)"));
+            if !mass_ok(value) {
+                return Err(invalid(
+                    "a mass must be a number from 1e-30 to 1e30 (kg): squeal's arithmetic cannot resolve masses beyond",
+                ));
             }
             self.masses[i] = value;
             refresh = true;
@@ -2214,6 +2272,18 @@ impl Lumped {
         }
         a
     }
+}
+
+/// The masses a model may have (kg, or kg·m² for a rotation): from 1e-30 to
+/// 1e30. Beyond, `1/m` vanishes beside the other masses' in double
+/// precision (a pad of 1e300 kg leaves the stick constraints of a two-pad
+/// brake numerically dependent) or overflows: such a mass is refused as a
+/// bad mass, naming it, rather than surfacing as a numerical failure.
+pub const MASS_RANGE: (f64, f64) = (1e-30, 1e30);
+
+/// Whether `m` is a mass squeal accepts ([`MASS_RANGE`]).
+pub fn mass_ok(m: f64) -> bool {
+    m.is_finite() && (MASS_RANGE.0..=MASS_RANGE.1).contains(&m)
 }
 
 /// Most dofs a model may have (10⁶, an FE brake at full size): checked from
