@@ -142,6 +142,11 @@ impl Default for FrictionLaw {
     }
 }
 
+/// Round-off (in units of the larger side's last place) that relations
+/// between friction parameters tolerate: values computed on a grid
+/// (`0.1 + 7·0.05`) miss their exact decimal by a few ulps.
+pub const RELATION_ULPS: f64 = 8.0;
+
 impl FrictionLaw {
     /// The law called `name` with its default parameters.
     pub fn by_name(name: &str) -> Result<Self, ParamError> {
@@ -250,14 +255,17 @@ impl FrictionLaw {
     }
 
     /// Check relations between parameters: `mu_s ≥ mu_k`, and a thesis law
-    /// whose friction stays non-negative (`f1·Uc ≤ 2`, so μ(Uc) ≥ 0).
+    /// whose friction stays non-negative (`f1·Uc ≤ 2`, so μ(Uc) ≥ 0). Both
+    /// tolerate [`RELATION_ULPS`] units of round-off: a map step that lands
+    /// `mu_k` on 0.45000000000000007 beside `mu_s = 0.45` is equality.
     pub fn validate(&self) -> Result<(), ParamError> {
         for spec in self.params() {
             spec.check(self.get(spec.name).unwrap_or(f64::NAN))?;
         }
+        let slack = |x: f64| RELATION_ULPS * f64::EPSILON * x.abs();
         match *self {
             FrictionLaw::Coulomb { mu_s, mu_k } | FrictionLaw::Stribeck { mu_s, mu_k, .. }
-                if mu_s < mu_k =>
+                if mu_s < mu_k - slack(mu_k) =>
             {
                 Err(ParamError::Relation {
                     key: "mu_s".into(),
@@ -265,14 +273,16 @@ impl FrictionLaw {
                     why: format!("must be ≥ mu_k = {mu_k}"),
                 })
             }
-            FrictionLaw::Thesis { f1, uc, .. } if f1 * uc > 2.0 => Err(ParamError::Relation {
-                key: "f1".into(),
-                value: f1,
-                why: format!(
-                    "f1·Uc = {} > 2 makes the friction coefficient negative near Uc",
-                    f1 * uc
-                ),
-            }),
+            FrictionLaw::Thesis { f1, uc, .. } if f1 * uc > 2.0 + slack(2.0) => {
+                Err(ParamError::Relation {
+                    key: "f1".into(),
+                    value: f1,
+                    why: format!(
+                        "f1·Uc = {} > 2 makes the friction coefficient negative near Uc",
+                        f1 * uc
+                    ),
+                })
+            }
             _ => Ok(()),
         }
     }
@@ -397,6 +407,25 @@ impl FrictionLaw {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn relations_tolerate_round_off_but_not_more() {
+        // A map step lands mu_k on 0.45000000000000007 beside mu_s = 0.45:
+        // equal up to one ulp, accepted (issue 26 §3).
+        let grid_mu_k = 0.1 + 7.0 * 0.05;
+        assert_eq!(grid_mu_k, 0.45000000000000007);
+        let ok = FrictionLaw::Coulomb {
+            mu_s: 0.45,
+            mu_k: grid_mu_k,
+        };
+        assert!(ok.validate().is_ok());
+        // A real violation, 1e-12 relative, is still refused.
+        let bad = FrictionLaw::Coulomb {
+            mu_s: 0.45,
+            mu_k: 0.45 * (1.0 + 1e-12),
+        };
+        assert!(matches!(bad.validate(), Err(ParamError::Relation { .. })));
+    }
 
     #[test]
     fn thesis_law_matches_model_md_numbers() {
