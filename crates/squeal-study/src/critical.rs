@@ -55,8 +55,13 @@ pub fn locate(
         ))
         .into());
     }
-    check_endpoints(model, name, lo, hi)
-        .map_err(|why| InputError(format!("--param {name}={lo}:{hi}: {why}")))?;
+    check_endpoints(model, name, lo, hi).map_err(|why| {
+        InputError(format!(
+            "--param {name}={}:{}: {why}",
+            squeal_core::params::short(lo),
+            squeal_core::params::short(hi)
+        ))
+    })?;
     let opts = CriticalOptions {
         grid,
         ..CriticalOptions::default()
@@ -76,7 +81,9 @@ pub fn locate(
         }
         growth_at(model, name, p).map_err(|e| match e {
             StabilityError::NonFinite { what } => StabilityError::BadInput(format!(
-                "--param {name}={lo}:{hi}: at {name} = {p:e} the {what} at steady sliding is not finite (it overflows)"
+                "--param {name}={}:{}: at {name} = {p:e} the {what} at steady sliding is not finite (it overflows)",
+                squeal_core::params::short(lo),
+                squeal_core::params::short(hi)
             )),
             other => other,
         })
