@@ -16,4 +16,5 @@ mod modal;
 mod padding;
 mod projected;
 mod stability;
+mod steady;
 mod sweep;

@@ -6,6 +6,7 @@
 
 use crate::scenario::InputError;
 use squeal_core::model::contact::Normal;
+use squeal_core::model::lumped::shared::Shared;
 use squeal_core::model::lumped::MAX_MODEL_DOFS;
 use squeal_core::model::lumped::{ContactSpec, ForceSpec, LumpedSpec, SpringSpec, Terms, Triplets};
 use squeal_core::{FrictionLaw, Lumped};
@@ -20,7 +21,9 @@ pub struct MatrixFiles {
 }
 
 /// The top-level keys a lumped scenario adds.
-pub const LUMPED_KEYS: [&str; 6] = ["dofs", "masses", "spring", "force", "contact", "matrices"];
+pub const LUMPED_KEYS: [&str; 7] = [
+    "dofs", "masses", "spring", "force", "contact", "matrices", "params",
+];
 
 fn err<T>(msg: impl Into<String>) -> Result<T, InputError> {
     Err(InputError(msg.into()))
@@ -31,20 +34,53 @@ fn required<'a>(what: &str, t: &'a toml::Table, key: &str) -> Result<&'a toml::V
         .ok_or_else(|| InputError(format!("{what}: {key}: missing")))
 }
 
-/// A number an element may leave out (`default` then).
-fn optional_number(
-    what: &str,
-    t: &toml::Table,
-    key: &str,
-    default: f64,
-) -> Result<f64, InputError> {
-    t.get(key).map_or(Ok(default), |v| number(what, key, v))
+/// The `[params]` of a file and the keys bound to expressions of them.
+struct Exprs {
+    shared: Shared,
+    bound: Vec<(String, String)>,
+}
+
+impl Exprs {
+    /// A number, or a string holding an expression of `[params]` bound to
+    /// the element key `el.key` (its value now).
+    fn value(
+        &mut self,
+        what: &str,
+        el: &str,
+        key: &str,
+        v: &toml::Value,
+    ) -> Result<f64, InputError> {
+        match v {
+            toml::Value::String(src) => {
+                let full = format!("{el}.{key}");
+                let x = self
+                    .shared
+                    .bind(&full, src)
+                    .map_err(|e| InputError(format!("{what}: {e}")))?;
+                self.bound.push((full, src.clone()));
+                Ok(x)
+            }
+            other => number(what, key, other),
+        }
+    }
+    fn optional(
+        &mut self,
+        what: &str,
+        el: &str,
+        t: &toml::Table,
+        key: &str,
+    ) -> Result<Option<f64>, InputError> {
+        t.get(key).map(|v| self.value(what, el, key, v)).transpose()
+    }
 }
 
 fn number(what: &str, key: &str, v: &toml::Value) -> Result<f64, InputError> {
     match v {
         toml::Value::Float(x) => Ok(*x),
         toml::Value::Integer(i) => Ok(*i as f64),
+        toml::Value::String(s) => err(format!(
+            "{what}: {key} = \"{s}\": expected a number (coefficients take numbers; element values such as k, value, mu_k may name [params])"
+        )),
         other => err(format!("{what}: {key} = {other}: expected a number")),
     }
 }
@@ -105,6 +141,20 @@ pub fn parse(
 ) -> Result<(Lumped, MatrixFiles), InputError> {
     let mut spec = LumpedSpec::default();
     let mut files = MatrixFiles::default();
+    if let Some(p) = table.get("params") {
+        let toml::Value::Table(p) = p else {
+            return err(format!(
+                "params = {p}: expected a table [params] of name = number"
+            ));
+        };
+        for (k, v) in p {
+            spec.params.push((k.clone(), number("params", k, v)?));
+        }
+    }
+    let mut ex = Exprs {
+        shared: Shared::new(&spec.params).map_err(InputError)?,
+        bound: Vec::new(),
+    };
     if let Some(m) = table.get("matrices") {
         let toml::Value::Table(m) = m else {
             return err(format!(
@@ -197,7 +247,8 @@ pub fn parse(
             ));
         };
         for (d, v) in m {
-            spec.masses.push((d.clone(), number("masses", d, v)?));
+            spec.masses
+                .push((d.clone(), ex.value("masses", "mass", d, v)?));
         }
     }
     for (i, t) in tables(table, "spring")?.into_iter().enumerate() {
@@ -205,8 +256,8 @@ pub fn parse(
         let what = format!("spring '{name}'");
         check_keys(&what, t, &["name", "on", "k", "c"])?;
         let on = terms(&what, "on", required(&what, t, "on")?)?;
-        let k = number(&what, "k", required(&what, t, "k")?)?;
-        let c = optional_number(&what, t, "c", 0.0)?;
+        let k = ex.value(&what, &name, "k", required(&what, t, "k")?)?;
+        let c = ex.optional(&what, &name, t, "c")?.unwrap_or(0.0);
         spec.springs.push(SpringSpec { name, on, k, c });
     }
     for (i, t) in tables(table, "force")?.into_iter().enumerate() {
@@ -214,8 +265,8 @@ pub fn parse(
         let what = format!("force '{name}'");
         check_keys(&what, t, &["name", "on", "value", "ramp"])?;
         let on = terms(&what, "on", required(&what, t, "on")?)?;
-        let value = number(&what, "value", required(&what, t, "value")?)?;
-        let ramp = optional_number(&what, t, "ramp", 0.0)?;
+        let value = ex.value(&what, &name, "value", required(&what, t, "value")?)?;
+        let ramp = ex.optional(&what, &name, t, "ramp")?.unwrap_or(0.0);
         spec.forces.push(ForceSpec {
             name,
             on,
@@ -250,7 +301,7 @@ pub fn parse(
         check_keys(&what, t, &allowed)?;
         for p in friction.params() {
             if let Some(v) = t.get(p.name) {
-                let x = number(&what, p.name, v)?;
+                let x = ex.value(&what, &name, p.name, v)?;
                 friction
                     .set(p.name, x)
                     .map_err(|e| InputError(format!("{what}: {e}")))?;
@@ -266,24 +317,28 @@ pub fn parse(
                 ))
             }
         };
-        let opt = |key: &str| t.get(key).map(|v| number(&what, key, v)).transpose();
+        let k = ex.optional(&what, &name, t, "k")?;
+        let c = ex.optional(&what, &name, t, "c")?;
+        let normal_force = ex.optional(&what, &name, t, "normal_force")?;
+        let v = ex.optional(&what, &name, t, "V")?.unwrap_or(0.0);
+        let alpha = ex.optional(&what, &name, t, "alpha")?.unwrap_or(0.0);
         spec.contacts.push(ContactSpec {
             name,
             normal: t
                 .get("normal")
                 .map(|v| terms(&what, "normal", v))
                 .transpose()?,
-            k: opt("k")?,
-            c: opt("c")?,
+            k,
+            c,
             bilateral,
-            normal_force: opt("normal_force")?,
+            normal_force,
             tangent: t
                 .get("tangent")
                 .map(|v| terms(&what, "tangent", v))
                 .transpose()?,
-            v: opt("V")?.unwrap_or(0.0),
+            v,
             friction,
-            alpha: opt("alpha")?.unwrap_or(0.0),
+            alpha,
             slope: t
                 .get("slope")
                 .map(|v| terms(&what, "slope", v))
@@ -291,6 +346,7 @@ pub fn parse(
                 .unwrap_or_default(),
         });
     }
+    spec.expressions = ex.bound;
     let model = Lumped::build(&spec).map_err(|e| InputError(e.0))?;
     Ok((model, files))
 }
@@ -308,8 +364,23 @@ fn combo(l: &Lumped, c: &squeal_core::model::contact::Combination) -> String {
 /// The model's tables as TOML (current parameter values), for `scenario show`.
 pub fn to_toml(l: &Lumped, files: &MatrixFiles) -> String {
     let mut t = String::new();
+    // A value as written: its expression (with the value now) where the
+    // key is bound to one.
+    let val = |key: String, x: f64| match l.shared().binding(&key) {
+        Some(b) => format!("{:?}  # = {x:?}", b.source),
+        None => format!("{x:?}"),
+    };
     let dofs: Vec<String> = l.dofs().iter().map(|d| format!("{d:?}")).collect();
     let _ = writeln!(t, "dofs = [{}]", dofs.join(", "));
+    if !l.shared().is_empty() {
+        let _ = writeln!(
+            t,
+            "\n[params]                          # shared parameters: keys below may name them"
+        );
+        for (n, v) in l.shared().params() {
+            let _ = writeln!(t, "{n} = {v:?}");
+        }
+    }
     if !files.paths.is_empty() {
         let _ = writeln!(
             t,
@@ -330,29 +401,29 @@ pub fn to_toml(l: &Lumped, files: &MatrixFiles) -> String {
             "\n[masses]                          # kg (kg·m² for a rotation)"
         );
         for (d, m) in masses {
-            let _ = writeln!(t, "{d} = {m:?}");
+            let _ = writeln!(t, "{d} = {}", val(format!("mass.{d}"), m));
         }
     }
     for s in &l.springs {
         let _ = writeln!(
             t,
-            "\n[[spring]]\nname = {:?}\non = {}\nk = {:?}\nc = {:?}",
+            "\n[[spring]]\nname = {:?}\non = {}\nk = {}\nc = {}",
             s.name,
             combo(l, &s.on),
-            s.k,
-            s.c
+            val(format!("{}.k", s.name), s.k),
+            val(format!("{}.c", s.name), s.c)
         );
     }
     for f in &l.forces {
         let _ = writeln!(
             t,
-            "\n[[force]]\nname = {:?}\non = {}\nvalue = {:?}",
+            "\n[[force]]\nname = {:?}\non = {}\nvalue = {}",
             f.name,
             combo(l, &f.on),
-            f.value
+            val(format!("{}.value", f.name), f.value)
         );
         if f.ramp > 0.0 {
-            let _ = writeln!(t, "ramp = {:?}", f.ramp);
+            let _ = writeln!(t, "ramp = {}", val(format!("{}.ramp", f.name), f.ramp));
         }
     }
     for c in &l.contacts {
@@ -366,8 +437,10 @@ pub fn to_toml(l: &Lumped, files: &MatrixFiles) -> String {
             } => {
                 let _ = writeln!(
                     t,
-                    "normal = {}\nk = {k:?}\nc = {cc:?}\ncontact = {:?}",
+                    "normal = {}\nk = {}\nc = {}\ncontact = {:?}",
                     combo(l, normal),
+                    val(format!("{}.k", c.name), *k),
+                    val(format!("{}.c", c.name), *cc),
                     if *bilateral {
                         "bilateral"
                     } else {
@@ -376,26 +449,38 @@ pub fn to_toml(l: &Lumped, files: &MatrixFiles) -> String {
                 );
             }
             Normal::Prescribed(f) => {
-                let _ = writeln!(t, "normal_force = {f:?}");
+                let _ = writeln!(
+                    t,
+                    "normal_force = {}",
+                    val(format!("{}.normal_force", c.name), *f)
+                );
             }
         }
         let _ = writeln!(
             t,
-            "tangent = {}\nV = {:?}\nfriction = {:?}",
+            "tangent = {}\nV = {}\nfriction = {:?}",
             combo(l, &c.tangent),
-            c.v,
+            val(format!("{}.V", c.name), c.v),
             c.friction.name()
         );
         for p in c.friction.params() {
             let _ = writeln!(
                 t,
-                "{} = {:?}",
+                "{} = {}",
                 p.name,
-                c.friction.get(p.name).unwrap_or(f64::NAN)
+                val(
+                    format!("{}.{}", c.name, p.name),
+                    c.friction.get(p.name).unwrap_or(f64::NAN)
+                )
             );
         }
         if c.alpha != 0.0 || !c.slope.is_empty() {
-            let _ = writeln!(t, "alpha = {:?}\nslope = {}", c.alpha, combo(l, &c.slope));
+            let _ = writeln!(
+                t,
+                "alpha = {}\nslope = {}",
+                val(format!("{}.alpha", c.name), c.alpha),
+                combo(l, &c.slope)
+            );
         }
     }
     t

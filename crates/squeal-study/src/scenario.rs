@@ -343,9 +343,9 @@ impl Scenario {
                         s.apply_in("params", &format!("modal.{k}"), &setting)?;
                     }
                 }
-                ("params" | "friction", _) if lumped => {
+                ("friction", _) if lumped => {
                     return err(format!(
-                        "{key}: a lumped model takes its parameters in its elements ([[spring]], [[contact]], …)"
+                        "{key}: a lumped model takes its friction laws in its contacts ([[contact]] friction = …, or --set <contact>.friction=<law>)"
                     ))
                 }
                 ("name", toml::Value::String(v)) => {
@@ -398,7 +398,51 @@ impl Scenario {
             self.apply(k, &Setting::Text(v.clone()))
                 .map_err(|e| InputError(format!("--set {raw}: {}", e.0)))?;
         }
-        for (k, v, raw) in parsed.iter().filter(|(k, ..)| k != "friction") {
+        // A lumped contact's law: `--set inner.friction=coulomb`, then the
+        // new law's keys are required among the other --set values.
+        let contacts: Vec<String> = match &self.model {
+            AnyModel::Lumped(l) => l.contacts.iter().map(|c| c.name.clone()).collect(),
+            _ => Vec::new(),
+        };
+        let law_key = |k: &str| {
+            k.strip_suffix(".friction")
+                .filter(|c| contacts.iter().any(|x| x == c))
+                .map(str::to_string)
+        };
+        let switches: Vec<(String, String, &String)> = parsed
+            .iter()
+            .filter_map(|(k, v, raw)| law_key(k).map(|c| (c, v.clone(), *raw)))
+            .collect();
+        for (contact, law, raw) in &switches {
+            let AnyModel::Lumped(l) = &mut self.model else {
+                unreachable!("law_key matches lumped contacts only")
+            };
+            let new = FrictionLaw::by_name(law).map_err(|_| {
+                InputError(format!(
+                    "--set {raw}: expected one of {}",
+                    LAW_NAMES.join(", ")
+                ))
+            })?;
+            let missing: Vec<String> = new
+                .params()
+                .iter()
+                .map(|p| format!("{contact}.{}", p.name))
+                .filter(|k| !parsed.iter().any(|(pk, ..)| pk == k))
+                .collect();
+            if !missing.is_empty() {
+                return err(format!(
+                    "--set {raw}: the {law} law needs its keys set too; missing: {} (e.g. --set {}=…)",
+                    missing.join(", "),
+                    missing[0]
+                ));
+            }
+            l.set_friction_law(contact, new)
+                .map_err(|e| InputError(format!("--set {raw}: {e}")))?;
+        }
+        for (k, v, raw) in parsed
+            .iter()
+            .filter(|(k, ..)| k != "friction" && law_key(k).is_none())
+        {
             let setting = match v.parse::<f64>() {
                 Ok(x) => Setting::Number(x),
                 Err(_) => Setting::Text(v.clone()),
@@ -719,6 +763,22 @@ impl Scenario {
         }
         if let AnyModel::DiscPad(m) = &self.model {
             out["contact"] = json!(m.contact.as_str());
+        }
+        if let AnyModel::Lumped(l) = &self.model {
+            // Keys bound to expressions of [params]: each with its value.
+            let b = l.shared().bindings();
+            if !b.is_empty() {
+                out["expressions"] = b
+                    .iter()
+                    .map(|b| {
+                        (
+                            b.key.clone(),
+                            json!({ "expr": b.source, "value": l.get(&b.key) }),
+                        )
+                    })
+                    .collect::<Map<String, Value>>()
+                    .into();
+            }
         }
         out
     }

@@ -5,6 +5,7 @@
 mod cli;
 mod cycle_cli;
 mod lumped_cli;
+mod params_cli;
 mod reliability;
 mod reliability_inputs;
 mod reliability_limits;

@@ -245,6 +245,12 @@ pub struct LumpedSpec {
     pub forces: Vec<ForceSpec>,
     /// Contacts.
     pub contacts: Vec<ContactSpec>,
+    /// `[params]`: shared, named parameters (`mu = 0.45`), in order.
+    pub params: Vec<(String, f64)>,
+    /// Element keys bound to expressions of `params` (`("inner.mu_k",
+    /// "mu")`); the spec's numbers for these keys are replaced by the
+    /// expressions' values when the model is built.
+    pub expressions: Vec<(String, String)>,
 }
 
 /// `M⁻¹`: diagonal, or dense row-major.
@@ -276,6 +282,8 @@ pub struct Lumped {
     /// How the complex eigenvalue analysis is solved (dense or projected;
     /// keys `modal.dense_max_dofs`, `modal.modes`, `modal.cutoff_hz`).
     pub modal: ModalOptions,
+    /// Shared parameters and the keys bound to them (see [`shared`]).
+    shared: shared::Shared,
     // Derived from the above by `refresh`.
     inv_mass: InvMass,
     /// `M⁻¹ t_j` per contact, dense.
@@ -720,6 +728,7 @@ impl Lumped {
             forces,
             contacts,
             modal: ModalOptions::default(),
+            shared: shared::Shared::new(&spec.params).map_err(SpecError)?,
             inv_mass: InvMass::Diagonal(Vec::new()),
             minv_t: Vec::new(),
             gram: [[0.0; MAX_CONTACTS]; MAX_CONTACTS],
@@ -728,6 +737,12 @@ impl Lumped {
             dense: None,
         };
         model.refresh()?;
+        for (key, source) in &spec.expressions {
+            let x = model.shared.bind(key, source).map_err(SpecError)?;
+            model
+                .set_element(key, x)
+                .map_err(|e| SpecError(format!("{key} = \"{source}\": {e}")))?;
+        }
         Ok(model)
     }
 
@@ -1580,49 +1595,6 @@ impl Lumped {
         m
     }
 
-    /// Steady sliding by Newton's method on the positions (velocities zero,
-    /// every contact sliding in the direction of its V): the generalised
-    /// force vanishes. Converges when the update is below 1e-14 of the
-    /// positions' size.
-    pub fn equilibrium_dyn(&self) -> Result<Vec<f64>, ModelError> {
-        let n = self.dofs.len();
-        if let Some(c) = self.contacts.iter().find(|c| c.v == 0.0) {
-            return Err(ModelError::NoSteadySliding(format!(
-                "contact '{}': V = 0 (the surface must move)",
-                c.name
-            )));
-        }
-        let modes = self.steady_modes();
-        let mut acc = vec![0.0; n];
-        let mut z = vec![0.0; 2 * n];
-        let q = super::newton_positions(
-            &vec![0.0; n],
-            |q| {
-                z[..n].copy_from_slice(q);
-                let (q, u) = z.split_at(n);
-                self.force(f64::INFINITY, &modes, q, u, &mut acc);
-                let jf = self.force_jacobian(&modes, &z);
-                (
-                    jf.columns(0, n).into_owned(),
-                    nalgebra::DVector::from_column_slice(&acc),
-                )
-            },
-            "the steady-sliding equations are singular (is every dof held by a spring or a contact?)",
-        )?;
-        let mut z = vec![0.0; 2 * n];
-        z[..n].copy_from_slice(&q);
-        for c in &self.contacts {
-            let f_n = c.normal_force(&z[..n], &z[n..]);
-            if c.can_open() && f_n <= 0.0 {
-                return Err(ModelError::NoSteadySliding(format!(
-                    "contact '{}': the normal force at steady sliding, {f_n:.3e} N, is not positive",
-                    c.name
-                )));
-            }
-        }
-        Ok(z)
-    }
-
     /// Forces and sliding velocity of contact `i` (any size).
     pub fn observe_dyn(&self, t: f64, modes: &Modes, z: &[f64], i: usize) -> Observables {
         let n = self.dofs.len();
@@ -1685,7 +1657,11 @@ impl Lumped {
 
     /// Every parameter key with its current value, in file order.
     pub fn keys(&self) -> Vec<(String, f64)> {
-        let mut out = Vec::new();
+        let mut out: Vec<(String, f64)> = self
+            .shared
+            .params()
+            .map(|(n, v)| (n.to_string(), v))
+            .collect();
         for (d, m) in self.dofs.iter().zip(&self.masses) {
             if *m > 0.0 {
                 out.push((format!("mass.{d}"), *m));
@@ -1721,6 +1697,9 @@ impl Lumped {
 
     /// Value of a parameter by key.
     pub fn get(&self, key: &str) -> Option<f64> {
+        if let Some(v) = self.shared.get(key) {
+            return Some(v);
+        }
         if let Some(v) = self.modal_get(key) {
             return Some(v);
         }
@@ -1735,7 +1714,56 @@ impl Lumped {
     /// `<element>.<key>`, `mass.<dof>` and the analysis options
     /// `modal.dense_max_dofs`, `modal.modes`, `modal.cutoff_hz`
     /// ([`ModalOptions`]).
+    ///
+    /// A shared parameter of `[params]` (a key without a dot) sets every
+    /// key bound to it (all or nothing); setting a bound key directly
+    /// replaces its expression by the number.
     pub fn set(&mut self, key: &str, value: f64) -> Result<(), ParamError> {
+        if !key.contains('.') && self.shared.get(key).is_some() {
+            let mut next = self.shared.clone();
+            let moved = next.set(key, value)?;
+            let mut model = self.clone();
+            for (k, x) in &moved {
+                model.set_element(k, *x).map_err(|e| ParamError::Relation {
+                    key: key.into(),
+                    value,
+                    why: format!("makes {e}"),
+                })?;
+            }
+            model.shared = next;
+            *self = model;
+            return Ok(());
+        }
+        self.set_element(key, value)?;
+        self.shared.unbind(key);
+        Ok(())
+    }
+
+    /// Switch contact `contact`'s friction law to `law` (with the values
+    /// it carries); the old law's keys lose their expressions.
+    pub fn set_friction_law(&mut self, contact: &str, law: FrictionLaw) -> Result<(), ParamError> {
+        let c = self
+            .contacts
+            .iter_mut()
+            .find(|c| c.name == contact)
+            .ok_or_else(|| ParamError::Unknown {
+                key: format!("{contact}.friction"),
+            })?;
+        for p in c.friction.params() {
+            self.shared.unbind(&format!("{contact}.{}", p.name));
+        }
+        c.friction = law;
+        self.rebuild_dense();
+        Ok(())
+    }
+
+    /// The shared parameters and their bindings.
+    pub fn shared(&self) -> &shared::Shared {
+        &self.shared
+    }
+
+    /// Set one element key (no shared parameter).
+    fn set_element(&mut self, key: &str, value: f64) -> Result<(), ParamError> {
         let invalid = |why: &str| ParamError::Invalid {
             key: key.into(),
             value,
@@ -1838,6 +1866,17 @@ impl Lumped {
 
     /// Unit and meaning of a parameter key (for tables and axis labels).
     pub fn describe(&self, key: &str) -> Option<(&'static str, String)> {
+        if self.shared.get(key).is_some() {
+            let users = self.shared.users(key);
+            return Some((
+                "",
+                if users.is_empty() {
+                    format!("shared parameter {key} (used by no key)")
+                } else {
+                    format!("shared parameter {key} (sets {})", users.join(", "))
+                },
+            ));
+        }
         let (el, k) = key.split_once('.')?;
         if el == "mass" {
             return Some(("kg", format!("mass of dof {k}")));
@@ -1882,6 +1921,15 @@ impl Lumped {
     /// The kind of values a key takes (sign), for lever and map ranges.
     pub fn kind_of(&self, key: &str) -> crate::params::ParamKind {
         use crate::params::ParamKind;
+        if self.shared.get(key).is_some() {
+            // The kind of the key it sets, when it is the bare name.
+            return self
+                .shared
+                .bindings()
+                .iter()
+                .find(|b| b.source.trim() == key)
+                .map_or(ParamKind::Any, |b| self.kind_of(&b.key));
+        }
         let (el, k) = key.split_once('.').unwrap_or(("", key));
         if el == "mass" {
             return ParamKind::Positive;
@@ -2299,6 +2347,8 @@ pub const MAX_SIM_DOFS: usize = 64;
 
 pub mod lanes;
 pub mod padding;
+pub mod shared;
+mod steady;
 pub use padding::{embed, padded_dofs, padded_solver, real_states, MAX_EXACT_DOFS, PADDED_DOFS};
 
 /// A lumped model seen at one state count `N = 2·dofs`, so that generic code

@@ -1,4 +1,4 @@
-//! `squeal scenario list | show NAME`.
+//! `squeal scenario list | show NAME|FILE`.
 
 use crate::run::RunError;
 use clap::Subcommand;
@@ -9,9 +9,11 @@ use squeal_study::scenario::{InputError, Scenario, BUILTINS};
 pub enum ScenarioCmd {
     /// List the built-in scenarios.
     List,
-    /// Print a built-in scenario (or a thesis set, thesis-01 … thesis-40) as a documented TOML file.
+    /// Print a built-in scenario (or a thesis set, thesis-01 … thesis-40, or a
+    /// scenario file, resolved: a lumped file's expressions with their values) as a
+    /// documented TOML file.
     Show {
-        /// Built-in scenario name.
+        /// Built-in scenario name, or a scenario file.
         name: String,
     },
 }
@@ -29,12 +31,19 @@ pub fn run(cmd: ScenarioCmd) -> Result<(), RunError> {
             }
         }
         ScenarioCmd::Show { name } => {
-            let s = Scenario::builtin(&name).ok_or_else(|| {
-                InputError(format!(
-                    "scenario '{name}': no built-in of that name (built-ins: {})",
-                    BUILTINS.join(", ")
-                ))
-            })?;
+            let s = match Scenario::builtin(&name) {
+                Some(s) => s,
+                None if name.ends_with(".toml") || std::path::Path::new(&name).is_file() => {
+                    Scenario::load(&name)?
+                }
+                None => {
+                    return Err(InputError(format!(
+                        "scenario '{name}': no built-in of that name (built-ins: {})",
+                        BUILTINS.join(", ")
+                    ))
+                    .into())
+                }
+            };
             crate::out::text(&s.to_toml());
         }
     }

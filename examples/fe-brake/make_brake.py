@@ -1,0 +1,217 @@
+#!/usr/bin/env python3
+"""A small FE disc brake, written as squeal scenarios with Matrix Market files.
+
+The disc is a ring of mean radius R cut open into a straight beam of length
+2*pi*R with periodic ends (curvature neglected), meshed with N two-node
+elements. Each node n has three dofs:
+
+    n_1  circumferential (in-plane) displacement u   (bar:   EA)
+    n_3  out-of-plane displacement w                 (beam:  EI, Euler-Bernoulli)
+    n_5  rotation theta = dw/ds                      (beam)
+
+with consistent element mass matrices and Rayleigh damping C = a*M + b*K.
+The hub holds the ring with springs on u and w at every node. Each pad is a
+rigid block with a tangential dof (`<id>_1`) on a caliper spring and a
+normal dof (`<id>_3`) pressed by the brake force. A pad touches the disc's
+surface at a node: the compression is the normal gap, and the sliding
+velocity is V plus the disc surface's tangential velocity, u -/+ (h/2)*theta
+(the surface is half a thickness from the beam's axis: friction there bends
+the disc, the coupling behind mode-coupling squeal) minus the pad's.
+
+Dofs are named `<node>_<component>` as squeal names the dofs of Nastran,
+Abaqus and ANSYS files. Only NumPy and SciPy are used.
+
+    python3 make_brake.py --elements 40 --out .        # writes the two-pad and four-pad scenarios
+
+Every number written depends only on the arguments: the files are the same
+on every machine.
+"""
+
+import argparse
+import math
+import os
+
+import numpy as np
+import scipy.io
+import scipy.sparse as sp
+
+
+def ring(n_el, radius, thickness, width, e_mod, rho, hub_k):
+    """Stiffness and mass of the periodic ring (3 dofs per node)."""
+    length = 2.0 * math.pi * radius
+    le = length / n_el
+    area = width * thickness
+    inertia = width * thickness**3 / 12.0
+    ndof = 3 * n_el
+    k = sp.lil_matrix((ndof, ndof))
+    m = sp.lil_matrix((ndof, ndof))
+    # Bar (u): stiffness EA/le [[1,-1],[-1,1]], consistent mass rho*A*le/6 [[2,1],[1,2]].
+    kb = e_mod * area / le * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    mb = rho * area * le / 6.0 * np.array([[2.0, 1.0], [1.0, 2.0]])
+    # Euler-Bernoulli beam (w1, t1, w2, t2).
+    l = le
+    kbm = e_mod * inertia / l**3 * np.array(
+        [
+            [12.0, 6 * l, -12.0, 6 * l],
+            [6 * l, 4 * l * l, -6 * l, 2 * l * l],
+            [-12.0, -6 * l, 12.0, -6 * l],
+            [6 * l, 2 * l * l, -6 * l, 4 * l * l],
+        ]
+    )
+    mbm = rho * area * l / 420.0 * np.array(
+        [
+            [156.0, 22 * l, 54.0, -13 * l],
+            [22 * l, 4 * l * l, 13 * l, -3 * l * l],
+            [54.0, 13 * l, 156.0, -22 * l],
+            [-13 * l, -3 * l * l, -22 * l, 4 * l * l],
+        ]
+    )
+    for e in range(n_el):
+        a, b = e, (e + 1) % n_el
+        ub = [3 * a, 3 * b]
+        wb = [3 * a + 1, 3 * a + 2, 3 * b + 1, 3 * b + 2]
+        for i in range(2):
+            for j in range(2):
+                k[ub[i], ub[j]] += kb[i, j]
+                m[ub[i], ub[j]] += mb[i, j]
+        for i in range(4):
+            for j in range(4):
+                k[wb[i], wb[j]] += kbm[i, j]
+                m[wb[i], wb[j]] += mbm[i, j]
+    for node in range(n_el):
+        k[3 * node, 3 * node] += hub_k
+        k[3 * node + 1, 3 * node + 1] += hub_k
+    return k, m
+
+
+def fmt(x):
+    return repr(float(x))
+
+
+def write(out, name, n_el, pads, args):
+    """Write `<name>.toml` and its matrices for the given pads."""
+    k, m = ring(n_el, args.radius, args.thickness, args.width, 210e9, 7850.0, args.hub_k)
+    ndof_disc = 3 * n_el
+    ndof = ndof_disc + 2 * len(pads)
+    kk = sp.lil_matrix((ndof, ndof))
+    mm = sp.lil_matrix((ndof, ndof))
+    kk[:ndof_disc, :ndof_disc] = k
+    mm[:ndof_disc, :ndof_disc] = m
+    names = []
+    for node in range(1, n_el + 1):
+        names += [f"{node}_1", f"{node}_3", f"{node}_5"]
+    for i, p in enumerate(pads):
+        j = ndof_disc + 2 * i
+        mm[j, j] = p["mass"]
+        mm[j + 1, j + 1] = p["mass"]
+        # The abutment holds the pad on a spring inclined by `incline` from
+        # the disc's surface (it couples the pad's tangential and normal
+        # motion, the mechanism of Hoffmann's minimal squeal model); the
+        # piston holds the normal dof.
+        ca, sa = math.cos(args.incline), math.sin(args.incline)
+        kk[j, j] = p["k_caliper"] * ca * ca
+        kk[j, j + 1] = kk[j + 1, j] = p["k_caliper"] * ca * sa * p["side"]
+        kk[j + 1, j + 1] = p["k_caliper"] * sa * sa + p["k_piston"]
+        names += [f"{p['id']}_1", f"{p['id']}_3"]
+    c = args.damping_a * mm + args.damping_b * kk
+    folder = os.path.join(out, name)
+    os.makedirs(folder, exist_ok=True)
+    for key, mat in (("M", mm), ("K", kk), ("C", c)):
+        scipy.io.mmwrite(
+            os.path.join(folder, f"{key}.mtx"),
+            sp.coo_matrix(mat),
+            symmetry="symmetric",
+            precision=17,
+        )
+    half = args.thickness / 2.0
+    lines = [
+        f"# Written by make_brake.py --elements {n_el}: a ring disc of {n_el} beam elements",
+        f"# ({ndof_disc} dofs) and {len(pads)} pads ({2 * len(pads)} dofs). Do not edit: regenerate.",
+        f'name = "{name}"',
+        f'description = "An FE ring disc ({n_el} beam elements) with {len(pads)} pads, from Matrix Market files."',
+        'model = "lumped"',
+        "duration = 0.05",
+        "sample_rate = 200000.0",
+        'initial = "equilibrium"',
+        "dofs = [" + ", ".join(f'"{d}"' for d in names) + "]",
+        "",
+        "[matrices]",
+        'M = "M.mtx"',
+        'K = "K.mtx"',
+        'C = "C.mtx"',
+    ]
+    for p in pads:
+        node = p["node"]
+        side = p["side"]  # +1: pad on the +w face, pressing towards -w
+        pid = p["id"]
+        surface = f"{{ {node}_1 = 1.0, {node}_5 = {fmt(-side * half)}, {pid}_1 = -1.0 }}"
+        if side > 0:
+            normal = f"{{ {node}_3 = 1.0, {pid}_3 = -1.0 }}"
+        else:
+            normal = f"{{ {pid}_3 = 1.0, {node}_3 = -1.0 }}"
+        lines += [
+            "",
+            "[[force]]",
+            f'name = "brake_{pid}"',
+            f"on = {{ {pid}_3 = 1.0 }}",
+            f"value = {fmt(-side * p['force_share'] * args.force)}",
+            "",
+            "[[contact]]",
+            f'name = "{p["name"]}"',
+            f"normal = {normal}",
+            f"k = {fmt(p['k_contact'])}",
+            f"c = {fmt(p['c_contact'])}",
+            'contact = "unilateral"',
+            f"tangent = {surface}",
+            f"V = {fmt(args.speed)}",
+            'friction = "coulomb"',
+            f"mu_s = {fmt(p['mu_ratio'] * args.mu * 1.2)}",
+            f"mu_k = {fmt(p['mu_ratio'] * args.mu)}",
+        ]
+    with open(os.path.join(folder, "brake.toml"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return ndof
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--elements", type=int, default=40)
+    ap.add_argument("--radius", type=float, default=0.15)
+    ap.add_argument("--thickness", type=float, default=0.02)
+    ap.add_argument("--width", type=float, default=0.05)
+    ap.add_argument("--hub-k", type=float, default=1.0e6)
+    ap.add_argument("--caliper-k", type=float, default=4.0e7)
+    ap.add_argument("--piston-k", type=float, default=5.0e6)
+    ap.add_argument("--incline", type=float, default=0.5, help="abutment angle (rad)")
+    ap.add_argument("--damping-a", type=float, default=2.0)
+    ap.add_argument("--damping-b", type=float, default=1.0e-8)
+    ap.add_argument("--mu", type=float, default=0.45)
+    ap.add_argument("--force", type=float, default=2000.0)
+    ap.add_argument("--speed", type=float, default=5.0)
+    ap.add_argument("--out", default=".")
+    args = ap.parse_args()
+    n = args.elements
+
+    def pad(name, pid, node, side, k_contact, mu_ratio=1.0, share=0.5, mass=0.3, k_cal=args.caliper_k, k_pis=args.piston_k):
+        return dict(
+            name=name, id=pid, node=node, side=side, k_contact=k_contact,
+            c_contact=0.0, mu_ratio=mu_ratio, force_share=share, mass=mass, k_caliper=k_cal, k_piston=k_pis,
+        )
+
+    a = n // 8 + 1
+    two = [
+        pad("inner", 9001, a, +1, 5.0e7),
+        pad("outer", 9002, a, -1, 4.0e7, mu_ratio=0.9, mass=0.35, k_cal=0.75 * args.caliper_k),
+    ]
+    b = a + n // 2
+    four = two + [
+        pad("inner2", 9003, b, +1, 4.5e7, mu_ratio=1.05, share=0.45, mass=0.28),
+        pad("outer2", 9004, b + 1, -1, 3.5e7, mu_ratio=0.95, share=0.45, mass=0.33, k_cal=0.875 * args.caliper_k),
+    ]
+    for name, pads in (("two-pad", two), ("four-pad", four)):
+        ndof = write(args.out, name, n, pads, args)
+        print(f"{name}: {ndof} dofs")
+
+
+if __name__ == "__main__":
+    main()
