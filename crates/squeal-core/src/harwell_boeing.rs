@@ -1,0 +1,356 @@
+//! Harwell–Boeing matrices (Duff, Grimes & Lewis, "Users' Guide for the
+//! Harwell-Boeing Sparse Matrix Collection", 1992): assembled real
+//! symmetric (`RSA`: one triangle stored column by column, as ANSYS's
+//! `HBMAT` writes K and M; expanded to both triangles) and unsymmetric
+//! (`RUA`, as SciPy's `scipy.io.hb_write` writes) square matrices.
+//!
+//! The header is 4 lines (5 with a right-hand side): title and key; the
+//! card counts `TOTCRD PTRCRD INDCRD VALCRD RHSCRD`; `MXTYPE NROW NCOL
+//! NNZERO NELTVL`; the Fortran formats of the pointers, row indices and
+//! values (`(10I8)`, `(I14)`, `(4E20.12)`, `(1P,4E20.12)`, `(d25.15)`, …),
+//! whose field widths are used to split the lines (numbers may run
+//! together). Then the column pointers, the row indices and the values,
+//! each section starting on a new line; a right-hand side after the values
+//! (HBMAT writes one by default) is skipped. Pattern-only (`P..`), complex
+//! (`C..`), skew, rectangular and elemental (`..E`) matrices are refused.
+//! Counts are checked against what the file holds, and nothing is allocated
+//! from a count before the file shows the data.
+//!
+//! ANSYS's mapping file (`HBMAT,…,Mapping=YES`, `Fname.mapping`): a header
+//! line `Matrix Eqn   Node   DOF`, then `equation node label` per line;
+//! it names the dofs `<node>_<component>` (`UX…ROTZ` → 1…6, other labels
+//! kept: `1203_PRES`). Without it the dofs are numbered
+//! ([`LabelledMatrix::labels`] is `None`).
+//! Pure: takes text; errors are one line, `line N: what is wrong`.
+
+use crate::labelled::{
+    ansys_component, fortran_real, is_integer, Entries, LabelledMatrix, Symmetry,
+};
+
+/// A Fortran edit descriptor's (repeat count, field width): `(10I8)` →
+/// (10, 8); `(1P,4E20.12)` → (4, 20); `(d25.15)` → (1, 25).
+fn fortran_format(f: &str) -> Option<(usize, usize)> {
+    let s: String = f
+        .trim()
+        .strip_prefix('(')?
+        .strip_suffix(')')?
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .collect::<String>()
+        .to_ascii_uppercase();
+    // a scale factor `kP` or `kP,` first
+    let s = match s.find('P') {
+        Some(p)
+            if s[..p]
+                .trim_start_matches('-')
+                .bytes()
+                .all(|b| b.is_ascii_digit()) =>
+        {
+            s[p + 1..].trim_start_matches(',').to_string()
+        }
+        _ => s,
+    };
+    let digits = s.bytes().take_while(u8::is_ascii_digit).count();
+    let repeat = if digits == 0 {
+        1
+    } else {
+        s[..digits].parse().ok()?
+    };
+    let rest = &s[digits..];
+    let rest = ["ES", "EN", "I", "E", "D", "F", "G"]
+        .iter()
+        .find_map(|l| rest.strip_prefix(l))?;
+    let w = rest.bytes().take_while(u8::is_ascii_digit).count();
+    let width: usize = rest[..w].parse().ok()?;
+    let tail = &rest[w..];
+    let ok_tail = tail.is_empty()
+        || (tail.starts_with('.') && tail[1..].bytes().all(|b| b.is_ascii_digit() || b == b'E'));
+    (repeat >= 1 && width >= 1 && ok_tail).then_some((repeat, width))
+}
+
+/// Read `count` numbers from `lines[start..]`, `per` per line in fields of
+/// `width`; returns them with their 1-based lines, and the next line index.
+fn section<T>(
+    lines: &[&str],
+    start: usize,
+    count: usize,
+    (per, width): (usize, usize),
+    what: &str,
+    read: impl Fn(&str) -> Option<T>,
+) -> Result<(Vec<(T, usize)>, usize), String> {
+    let mut out = Vec::new();
+    let mut i = start;
+    while out.len() < count {
+        let Some(l) = lines.get(i) else {
+            return Err(format!(
+                "line {}: the file ends after {} of the {count} {what} the header promises",
+                lines.len(),
+                out.len()
+            ));
+        };
+        let line = i + 1;
+        let chars: Vec<char> = l.chars().collect();
+        let want = per.min(count - out.len());
+        let mut got = 0;
+        for k in 0..want {
+            let a = k * width;
+            if a >= chars.len() {
+                break;
+            }
+            let field: String = chars[a..(a + width).min(chars.len())].iter().collect();
+            if field.trim().is_empty() {
+                if chars[a..].iter().all(|c| c.is_whitespace()) {
+                    break;
+                }
+                return Err(format!(
+                    "line {line}: blank field {} among the {what} (fields of {width} characters)",
+                    k + 1
+                ));
+            }
+            let v = read(field.trim()).ok_or_else(|| {
+                format!(
+                    "line {line}: '{}' is not one of the {what} (fields of {width} characters)",
+                    field.trim()
+                )
+            })?;
+            out.push((v, line));
+            got += 1;
+        }
+        if chars.len() > want * width && !chars[want * width..].iter().all(|c| c.is_whitespace()) {
+            return Err(format!(
+                "line {line}: more than {want} {what} on the line (the format gives {per} per line, {width} characters each)"
+            ));
+        }
+        if got == 0 {
+            return Err(format!(
+                "line {line}: blank line where the {what} should be ({} of {count} read)",
+                out.len()
+            ));
+        }
+        i += 1;
+    }
+    Ok((out, i))
+}
+
+fn index(s: &str) -> Option<usize> {
+    is_integer(s).then(|| s.parse::<usize>().ok()).flatten()
+}
+
+/// Parse a Harwell–Boeing text, with the text of ANSYS's mapping file if
+/// there is one (see the module docs). Errors name the line; errors in the
+/// mapping file say "mapping line N".
+pub fn parse(text: &str, mapping: Option<&str>) -> Result<LabelledMatrix, String> {
+    let lines: Vec<&str> = text.lines().collect();
+    if lines.len() < 4 {
+        return Err(format!(
+            "line {}: the file ends inside the 4-line Harwell-Boeing header",
+            lines.len()
+        ));
+    }
+    let counts: Vec<usize> = lines[1]
+        .split_whitespace()
+        .map(index)
+        .collect::<Option<_>>()
+        .filter(|c: &Vec<usize>| c.len() >= 4)
+        .ok_or_else(|| {
+            format!(
+                "line 2: expected the card counts 'TOTCRD PTRCRD INDCRD VALCRD [RHSCRD]', got '{}'",
+                lines[1].trim()
+            )
+        })?;
+    let rhscrd = counts.get(4).copied().unwrap_or(0);
+    let mut w3 = lines[2].split_whitespace();
+    let mxtype = w3.next().unwrap_or("").to_ascii_uppercase();
+    let dims: Vec<usize> = w3
+        .map(index)
+        .collect::<Option<_>>()
+        .filter(|d: &Vec<usize>| d.len() >= 3)
+        .ok_or_else(|| {
+            format!(
+                "line 3: expected 'MXTYPE NROW NCOL NNZERO [NELTVL]', got '{}'",
+                lines[2].trim()
+            )
+        })?;
+    let t: Vec<char> = mxtype.chars().collect();
+    if t.len() != 3 {
+        return Err(format!(
+            "line 3: matrix type '{mxtype}' is not three letters (RSA, RUA, …)"
+        ));
+    }
+    match t[0] {
+        'R' => {}
+        'P' => return Err(format!("line 3: matrix type {mxtype} is a pattern without values: squeal needs a real matrix (RSA or RUA)")),
+        'C' => return Err(format!("line 3: matrix type {mxtype} is complex: a mass, stiffness or damping matrix is real (RSA or RUA)")),
+        _ => return Err(format!("line 3: unknown matrix type {mxtype} (RSA or RUA)")),
+    }
+    let symmetry = match t[1] {
+        'S' | 'H' => Symmetry::Declared,
+        'U' => Symmetry::General,
+        'Z' => return Err(format!("line 3: matrix type {mxtype} is skew-symmetric: not supported (RSA or RUA)")),
+        'R' => return Err(format!("line 3: matrix type {mxtype} is rectangular: squeal reads square matrices (RSA or RUA)")),
+        _ => return Err(format!("line 3: unknown matrix type {mxtype} (RSA or RUA)")),
+    };
+    if t[2] != 'A' {
+        return Err(format!(
+            "line 3: matrix type {mxtype} is {}: squeal reads assembled matrices (RSA or RUA)",
+            if t[2] == 'E' { "elemental" } else { "unknown" }
+        ));
+    }
+    let (nrow, ncol, nnz) = (dims[0], dims[1], dims[2]);
+    if nrow != ncol {
+        return Err(format!(
+            "line 3: a {nrow}×{ncol} matrix: squeal reads square matrices"
+        ));
+    }
+    let mut formats = Vec::new();
+    let mut rest = lines[3];
+    while let Some(a) = rest.find('(') {
+        let mut depth = 0;
+        let mut end = None;
+        for (k, ch) in rest[a..].char_indices() {
+            match ch {
+                '(' => depth += 1,
+                ')' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        end = Some(a + k);
+                        break;
+                    }
+                }
+                _ => {}
+            }
+        }
+        let Some(e) = end else { break };
+        formats.push(&rest[a..=e]);
+        rest = &rest[e + 1..];
+    }
+    if formats.len() < 3 {
+        return Err(format!(
+            "line 4: expected the Fortran formats of the pointers, indices and values, got '{}'",
+            lines[3].trim()
+        ));
+    }
+    let fmt = |k: usize| {
+        fortran_format(formats[k]).ok_or_else(|| {
+            format!(
+                "line 4: Fortran format {} is not supported (a repeat count, a letter I, E, D, F or G, a width: (10I8), (1P,4E20.12))",
+                formats[k]
+            )
+        })
+    };
+    let (pf, inf, vf) = (fmt(0)?, fmt(1)?, fmt(2)?);
+    let start = if rhscrd > 0 { 5 } else { 4 };
+    if lines.len() < start {
+        return Err(format!(
+            "line {}: the file ends inside the 5-line header (RHSCRD = {rhscrd} announces a right-hand side line)",
+            lines.len()
+        ));
+    }
+    let (ptr, next) = section(
+        &lines,
+        start,
+        ncol.saturating_add(1),
+        pf,
+        "column pointers",
+        index,
+    )?;
+    let (ind, next) = section(&lines, next, nnz, inf, "row indices", index)?;
+    let (val, _) = section(&lines, next, nnz, vf, "values", fortran_real)?;
+    let labels = match mapping {
+        Some(m) => Some(read_mapping(m, ncol)?),
+        None => None,
+    };
+    let name = |i: usize| match &labels {
+        Some(l) => l[i].clone(),
+        None => (i + 1).to_string(),
+    };
+    if ptr[0].0 != 1 {
+        return Err(format!(
+            "line {}: the first column pointer is {}, not 1",
+            ptr[0].1, ptr[0].0
+        ));
+    }
+    let mut entries = Entries::default();
+    for j in 0..ncol {
+        let (a, b) = (ptr[j].0, ptr[j + 1].0);
+        if b < a || b > nnz + 1 {
+            return Err(format!(
+                "line {}: column pointer {b} (column {}) is {} (pointers rise from 1 to NNZERO + 1 = {})",
+                ptr[j + 1].1,
+                j + 2,
+                if b < a { "less than the one before" } else { "beyond the entries" },
+                nnz + 1
+            ));
+        }
+        for k in a - 1..b - 1 {
+            let (r, rl) = ind[k];
+            if r < 1 || r > nrow {
+                return Err(format!("line {rl}: row index {r} is outside 1…{nrow}"));
+            }
+            entries.add(r - 1, j, val[k].0, val[k].1, &name)?;
+        }
+    }
+    let (last, line) = ptr[ncol];
+    if last != nnz + 1 {
+        return Err(format!(
+            "line {line}: the last column pointer is {last}, not NNZERO + 1 = {}",
+            nnz + 1
+        ));
+    }
+    let (triplets, symmetric) = entries.finish(ncol, symmetry, &name)?;
+    Ok(LabelledMatrix {
+        name: String::new(),
+        format: "harwell-boeing",
+        labels,
+        triplets,
+        symmetric,
+    })
+}
+
+/// Dof labels of ANSYS's mapping file for an `n`-equation matrix.
+fn read_mapping(text: &str, n: usize) -> Result<Vec<String>, String> {
+    let mut labels: Vec<Option<String>> = vec![None; n];
+    let mut seen = std::collections::HashMap::new();
+    for (i, l) in text.lines().enumerate() {
+        let line = i + 1;
+        let w: Vec<&str> = l.split_whitespace().collect();
+        if w.is_empty() || !is_integer(w[0]) {
+            continue; // the header `Matrix Eqn  Node  DOF`
+        }
+        if w.len() != 3 {
+            return Err(format!(
+                "mapping line {line}: expected 'equation node dof', got '{}'",
+                l.trim()
+            ));
+        }
+        let e = match index(w[0]) {
+            Some(e) if e >= 1 && e <= n => e,
+            _ => {
+                return Err(format!(
+                    "mapping line {line}: equation {} is outside the matrix's 1…{n}",
+                    w[0]
+                ))
+            }
+        };
+        let node = w[1]
+            .parse::<i64>()
+            .map_err(|_| format!("mapping line {line}: node '{}' is not an integer", w[1]))?;
+        let label = format!("{node}_{}", ansys_component(w[2]));
+        if labels[e - 1].is_some() {
+            return Err(format!("mapping line {line}: equation {e} mapped twice"));
+        }
+        if let Some(first) = seen.insert(label.clone(), line) {
+            return Err(format!(
+                "mapping line {line}: dof {label} mapped twice (first on mapping line {first})"
+            ));
+        }
+        labels[e - 1] = Some(label);
+    }
+    labels
+        .into_iter()
+        .enumerate()
+        .map(|(i, l)| {
+            l.ok_or_else(|| format!("the mapping file has no line for equation {}", i + 1))
+        })
+        .collect()
+}
