@@ -144,3 +144,118 @@ pub fn parse(text: &str) -> Result<LabelledMatrix, String> {
         symmetric,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dmig::tests::{k_sym, u_unsym};
+    use crate::labelled::tests::dense_by;
+
+    /// The DMIG tests' matrix on Abaqus dofs: node 101's 1, 2, 3, node 102's
+    /// 3, and dof 8 of internal node −7.
+    const NODES: [(i64, u32); 5] = [(101, 1), (101, 2), (101, 3), (102, 3), (-7, 8)];
+    const LABELS: [&str; 5] = ["101_1", "101_2", "101_3", "102_3", "m7_8"];
+    const NUMBERS: [&str; 5] = ["1", "2", "3", "4", "5"];
+
+    /// `0`: lower triangle, `1`: upper, `2`: both.
+    fn write(a: &[Vec<f64>], part: u8, coordinate: bool) -> String {
+        let mut s = String::from("** written by the test\n");
+        for j in 0..5 {
+            for i in 0..5 {
+                let keep = match part {
+                    0 => i >= j,
+                    1 => i <= j,
+                    _ => true,
+                };
+                if keep && a[i][j] != 0.0 {
+                    if coordinate {
+                        s.push_str(&format!("{},{}, {:.16e}\n", i + 1, j + 1, a[i][j]));
+                    } else {
+                        let ((ni, di), (nj, dj)) = (NODES[i], NODES[j]);
+                        s.push_str(&format!("{ni},{di},{nj},{dj}, {:.16e}\n", a[i][j]));
+                    }
+                }
+            }
+        }
+        s
+    }
+
+    #[test]
+    fn both_formats_and_every_triangle_give_the_same_matrix() {
+        for coordinate in [false, true] {
+            let order: &[&str] = if coordinate { &NUMBERS } else { &LABELS };
+            for part in 0..3 {
+                let m = parse(&write(&k_sym(), part, coordinate)).unwrap();
+                assert!(m.symmetric);
+                assert_eq!(m.labels.is_none(), coordinate);
+                assert_eq!(
+                    m.format,
+                    if coordinate {
+                        "abaqus-coordinate"
+                    } else {
+                        "abaqus"
+                    }
+                );
+                assert_eq!(dense_by(&m, order), k_sym(), "{coordinate} {part}");
+            }
+            let m = parse(&write(&u_unsym(), 2, coordinate)).unwrap();
+            assert!(!m.symmetric);
+            assert_eq!(dense_by(&m, order), u_unsym());
+        }
+    }
+
+    #[test]
+    fn hand_written_files_entry_by_entry() {
+        let text = "** STIFFNESS MATRIX, step 1\n\n  12, 3, 12, 3,  1.0000000000000000e+06\n12,3,-4,11, -2.5e+02,\n -4, 11, -4, 11, 3.5D+02\n";
+        let m = parse(text).unwrap();
+        assert_eq!(m.labels.as_ref().unwrap(), &["12_3", "m4_11"]);
+        assert_eq!(
+            m.triplets.entries,
+            vec![(0, 0, 1e6), (0, 1, -250.0), (1, 0, -250.0), (1, 1, 350.0)]
+        );
+        assert!(m.symmetric);
+        assert_eq!(m.name, "");
+        let m = parse("1, 1, 2.0\n3, 1, -1.0\n").unwrap();
+        assert_eq!((m.triplets.rows, m.triplets.cols), (3, 3));
+        assert_eq!(
+            m.triplets.entries,
+            vec![(0, 0, 2.0), (2, 0, -1.0), (0, 2, -1.0)]
+        );
+    }
+
+    #[test]
+    fn bad_files_name_the_line() {
+        for (text, needle) in [
+            ("", "no matrix entries"),
+            ("** only a comment\n", "no matrix entries"),
+            (
+                "*USER ELEMENT, NODES=2\n",
+                "line 1: keyword line '*USER ELEMENT, NODES=2'",
+            ),
+            (
+                "1,1,1,1,2.0\n1,2,3.0\n",
+                "line 2: 3 fields, but line 1 has 5",
+            ),
+            ("1,1,2.0,4\n", "line 1: 4 fields: expected"),
+            ("1,1,1,1,abc\n", "line 1: 'abc' is not a real number"),
+            ("1,x,1,1,1.0\n", "line 1: dof 'x' is not an integer"),
+            ("1,0,1,1,1.0\n", "line 1: dof 0 is not a dof number"),
+            (
+                "1,1,1,1,1.0\n\n1,1,1,1,1.0\n",
+                "line 3: entry (row 1_1, column 1_1) given twice (first on line 1)",
+            ),
+            ("0,1,1.0\n", "line 1: equation number 0 is not 1 or more"),
+            (
+                "1,1,1.0\n1000,1,1.0\n",
+                "line 2: equation number 1000 is far beyond the 2 entries",
+            ),
+            (
+                "2,1,1.0\n1,2,1.0\n3,1,1.0\n1,3,2.0\n2,2,1.0\n2,2,1.0\n",
+                "line 6: entry (row 2, column 2) given twice",
+            ),
+        ] {
+            let e = parse(text).unwrap_err();
+            assert!(e.contains(needle), "{text:?}:\n{e}\nwanted: {needle}");
+        }
+    }
+}

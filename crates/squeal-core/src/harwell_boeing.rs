@@ -354,3 +354,318 @@ fn read_mapping(text: &str, n: usize) -> Result<Vec<String>, String> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dmig::tests::{k_sym, u_unsym};
+    use crate::labelled::tests::dense_by;
+
+    const NUMBERS: [&str; 5] = ["1", "2", "3", "4", "5"];
+
+    /// Write `a` (lower triangle if `symmetric`) with `per` values per line
+    /// in fields of `width` (`{:.prec E}`), pointers and indices as `(8I5)`.
+    fn write(a: &[Vec<f64>], symmetric: bool, per: usize, width: usize, prec: usize) -> String {
+        let n = a.len();
+        let (mut ptr, mut ind, mut val) = (vec![1], Vec::new(), Vec::new());
+        for j in 0..n {
+            for i in if symmetric { j } else { 0 }..n {
+                if a[i][j] != 0.0 {
+                    ind.push(i + 1);
+                    val.push(a[i][j]);
+                }
+            }
+            ptr.push(ind.len() + 1);
+        }
+        let lines = |k: usize, per: usize| k.div_ceil(per);
+        let (pc, ic, vc) = (
+            lines(ptr.len(), 8),
+            lines(ind.len(), 8),
+            lines(val.len(), per),
+        );
+        let mut s = format!(
+            "{:<72}{:<8}\n{:>14}{:>14}{:>14}{:>14}{:>14}\n{:<14}{:>14}{:>14}{:>14}{:>14}\n{:<16}{:<16}{:<20}\n",
+            "test matrix",
+            "KEY",
+            pc + ic + vc,
+            pc,
+            ic,
+            vc,
+            0,
+            if symmetric { "RSA" } else { "RUA" },
+            n,
+            n,
+            val.len(),
+            0,
+            "(8I5)",
+            "(8I5)",
+            format!("(1P,{per}E{width}.{prec})")
+        );
+        for chunk in ptr.chunks(8) {
+            s.extend(chunk.iter().map(|p| format!("{p:>5}")));
+            s.push('\n');
+        }
+        for chunk in ind.chunks(8) {
+            s.extend(chunk.iter().map(|p| format!("{p:>5}")));
+            s.push('\n');
+        }
+        for chunk in val.chunks(per) {
+            s.extend(
+                chunk
+                    .iter()
+                    .map(|v| format!("{:>width$}", format!("{v:.prec$E}"))),
+            );
+            s.push('\n');
+        }
+        s
+    }
+
+    #[test]
+    fn rsa_and_rua_give_the_same_matrix() {
+        for (per, width, prec) in [(4, 20, 12), (3, 25, 16), (5, 8, 3)] {
+            let m = parse(&write(&k_sym(), true, per, width, prec), None).unwrap();
+            assert!(m.symmetric);
+            assert_eq!(m.format, "harwell-boeing");
+            assert_eq!(m.labels, None);
+            // 8 stored entries of the lower triangle, 13 expanded
+            assert_eq!(m.triplets.entries.len(), 13);
+            assert_eq!(dense_by(&m, &NUMBERS), k_sym(), "{per} {width}");
+            let m = parse(&write(&u_unsym(), false, per, width, prec), None).unwrap();
+            assert!(!m.symmetric);
+            assert_eq!(dense_by(&m, &NUMBERS), u_unsym());
+        }
+        // (1P,5E8.3): the values run together
+        let text = write(&k_sym(), true, 5, 8, 3);
+        assert!(
+            text.contains(" 4.000E0-1.250E05.000E-1 3.000E02.500E-3"),
+            "{text}"
+        );
+    }
+
+    /// ANSYS's layout (HBMAT, ASCII, with a right-hand side and a mapping
+    /// file), as in a file exported by ANSYS 2020-era MAPDL.
+    const ANSYS: &str = "\
+Stiffness matrix from ANSYS FULL file dumped into Harwell-Boeing format         
+            14             4             4             4             3
+RSA                        3             3             4             0
+(I14)           (I14)           (d25.15)            (d25.15)            
+F                          1             3
+             1
+             3
+             4
+             5
+             1
+             3
+             2
+             3
+    0.200000000000000D+01
+   -0.100000000000000D+01
+    0.300000000000000D+01
+    0.400000000000000D+01
+    0.000000000000000D+00
+    0.000000000000000D+00
+    0.100000000000000D+01
+";
+    const MAPPING: &str = "    Matrix Eqn          Node    DOF     
+             1           672    UX  
+             2           672    ROTY
+             3           673    PRES
+";
+
+    #[test]
+    fn ansys_hbmat_with_rhs_and_mapping() {
+        let m = parse(ANSYS, Some(MAPPING)).unwrap();
+        assert_eq!(m.labels.as_ref().unwrap(), &["672_1", "672_5", "673_PRES"]);
+        assert!(m.symmetric);
+        assert_eq!(
+            m.triplets.entries,
+            vec![
+                (0, 0, 2.0),
+                (2, 0, -1.0),
+                (0, 2, -1.0),
+                (1, 1, 3.0),
+                (2, 2, 4.0)
+            ]
+        );
+        let m = parse(ANSYS, None).unwrap();
+        assert_eq!(m.labels, None);
+        assert_eq!(m.triplets.entries.len(), 5);
+    }
+
+    #[test]
+    fn values_running_together_are_split_by_width() {
+        let text = "\
+title
+3 1 1 1
+RUA 2 2 3 0
+(3I2) (3I2) (3E10.3)
+ 1 3 4
+ 1 2 1
+-1.250E+00-3.000E-01 7.500E+02
+";
+        let m = parse(text, None).unwrap();
+        assert_eq!(
+            m.triplets.entries,
+            vec![(0, 0, -1.25), (1, 0, -0.3), (0, 1, 750.0)]
+        );
+    }
+
+    #[test]
+    fn fortran_formats() {
+        for (f, want) in [
+            ("(10I8)", Some((10, 8))),
+            ("(I14)", Some((1, 14))),
+            ("(4E20.12)", Some((4, 20))),
+            ("(1P4E20.12)", Some((4, 20))),
+            ("(1P,4E20.12)", Some((4, 20))),
+            ("(5E16.8)", Some((5, 16))),
+            ("(d25.15)", Some((1, 25))),
+            ("(3E25.16E3)", Some((3, 25))),
+            ("( 8F10.3 )", Some((8, 10))),
+            ("(4ES20.12)", Some((4, 20))),
+            ("(4(1X,E19.12))", None),
+            ("(A8)", None),
+            ("10I8", None),
+        ] {
+            assert_eq!(fortran_format(f), want, "{f}");
+        }
+    }
+
+    #[test]
+    fn bad_files_name_the_line() {
+        let good = write(&k_sym(), true, 4, 20, 12);
+        let lines: Vec<&str> = good.lines().collect();
+        let with = |k: usize, l: &str| {
+            let mut v = lines.clone();
+            v[k] = l;
+            v.join("\n")
+        };
+        let cut = |k: usize| lines[..k].join("\n");
+        for (text, needle) in [
+            (
+                "x\n".to_string(),
+                "line 1: the file ends inside the 4-line Harwell-Boeing header",
+            ),
+            (with(1, "a b c d"), "line 2: expected the card counts"),
+            (
+                with(2, "PSA 5 5 8 0"),
+                "line 3: matrix type PSA is a pattern without values",
+            ),
+            (with(2, "CUA 5 5 8 0"), "line 3: matrix type CUA is complex"),
+            (
+                with(2, "RSE 5 5 8 0"),
+                "line 3: matrix type RSE is elemental",
+            ),
+            (
+                with(2, "RRA 5 4 8 0"),
+                "line 3: matrix type RRA is rectangular",
+            ),
+            (with(2, "RUA 5 4 8 0"), "line 3: a 5×4 matrix"),
+            (
+                with(3, "(8I5) (8I5) (4(1X,E19.12))"),
+                "line 4: Fortran format (4(1X,E19.12)) is not supported",
+            ),
+            (
+                with(2, "RSA 5 5 10 0"),
+                "line 8: more than 1 row indices on the line",
+            ),
+            (
+                cut(9),
+                "line 9: the file ends after 8 of the 9 values the header promises",
+            ),
+            (
+                with(2, "RSA 500 500 9 0"),
+                "line 8: '.0000' is not one of the column pointers",
+            ),
+            (
+                with(2, "RSA 5000000000000 5000000000000 9 0"),
+                "line 8: '.0000' is not one of the column pointers",
+            ),
+            (
+                cut(7),
+                "line 7: the file ends after 0 of the 9 values the header promises",
+            ),
+            (
+                with(4, "    2    4    6    8    9   10"),
+                "line 5: the first column pointer is 2, not 1",
+            ),
+            (
+                with(4, "    1    4    3    8    9   10"),
+                "line 5: column pointer 3 (column 3) is less than the one before",
+            ),
+            (
+                with(4, "    1    4    6    8    9   11"),
+                "line 5: column pointer 11 (column 6) is beyond the entries",
+            ),
+            (
+                with(4, "    1    4    6    8    9    9"),
+                "line 5: the last column pointer is 9, not NNZERO + 1 = 10",
+            ),
+            (
+                with(5, "    1    2    4    2    5    3    4    9"),
+                "line 6: row index 9 is outside 1…5",
+            ),
+            (
+                with(5, "    1    1    4    2    5    3    4    4"),
+                "line 8: entry (row 1, column 1) given twice (first on line 8)",
+            ),
+            (
+                with(6, "    5    1"),
+                "line 7: more than 1 row indices on the line",
+            ),
+            (
+                with(7, "  4.000000000000E+00 -1.250000000000E+00  abc"),
+                "line 8: 'abc' is not one of the values",
+            ),
+            (
+                with(
+                    7,
+                    "  4.000000000000E+00                      5.000000000000E-01",
+                ),
+                "line 8: blank field 2 among the values",
+            ),
+            (
+                with(7, ""),
+                "line 8: blank line where the values should be (0 of 9 read)",
+            ),
+        ] {
+            let e = parse(&text, None).map(|_| ()).expect_err(&text);
+            assert!(e.contains(needle), "{text}\n{e}\nwanted: {needle}");
+        }
+        // a symmetric file giving both triangles with different values
+        let text =
+            "t\n3 1 1 1\nRSA 2 2 2 0\n(3I2) (3I2) (3E10.3)\n 1 2 3\n 2 1\n 1.000E+00 2.000E+00\n";
+        let e = parse(text, None).unwrap_err();
+        assert!(e.contains("line 7: entry (row 2, column 1) = 1 disagrees with (row 1, column 2) = 2 on line 7"), "{e}");
+        // the mapping file
+        for (map, needle) in [
+            (
+                "Matrix Eqn Node DOF\n1 672 UX\n2 672 UY\n",
+                "the mapping file has no line for equation 3",
+            ),
+            (
+                "1 672 UX\n2 672 UY\n3 673 UZ\n4 674 UX\n",
+                "mapping line 4: equation 4 is outside the matrix's 1…3",
+            ),
+            (
+                "1 672 UX\n2 672 UX\n3 673 UZ\n",
+                "mapping line 2: dof 672_1 mapped twice (first on mapping line 1)",
+            ),
+            (
+                "1 672 UX\n1 672 UY\n3 673 UZ\n",
+                "mapping line 2: equation 1 mapped twice",
+            ),
+            (
+                "1 672 UX\n2 672\n3 673 UZ\n",
+                "mapping line 2: expected 'equation node dof'",
+            ),
+            (
+                "1 672 UX\n2 x UY\n3 673 UZ\n",
+                "mapping line 2: node 'x' is not an integer",
+            ),
+        ] {
+            let e = parse(ANSYS, Some(map)).unwrap_err();
+            assert!(e.contains(needle), "{map}\n{e}\nwanted: {needle}");
+        }
+    }
+}

@@ -203,8 +203,29 @@ impl Entries {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// The `n`×`n` dense matrix of `m` with its dofs in the order `order`
+    /// (labels, or the numbers `1…n` for numbered dofs); each entry once.
+    pub(crate) fn dense_by(m: &LabelledMatrix, order: &[&str]) -> Vec<Vec<f64>> {
+        let n = order.len();
+        assert_eq!((m.triplets.rows, m.triplets.cols), (n, n));
+        let name = |i: usize| match &m.labels {
+            Some(l) => l[i].clone(),
+            None => (i + 1).to_string(),
+        };
+        if let Some(l) = &m.labels {
+            assert_eq!(l.len(), n, "{l:?}");
+        }
+        let pos = |i: usize| order.iter().position(|o| *o == name(i)).unwrap();
+        let mut d = vec![vec![0.0; n]; n];
+        for &(r, c, v) in &m.triplets.entries {
+            assert_eq!(d[pos(r)][pos(c)], 0.0, "entry ({r}, {c}) twice");
+            d[pos(r)][pos(c)] = v;
+        }
+        d
+    }
 
     #[test]
     fn fortran_reals() {
