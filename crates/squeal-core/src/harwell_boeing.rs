@@ -9,7 +9,9 @@
 //! NNZERO NELTVL`; the Fortran formats of the pointers, row indices and
 //! values (`(10I8)`, `(I14)`, `(4E20.12)`, `(1P,4E20.12)`, `(d25.15)`, …),
 //! whose field widths are used to split the lines (numbers may run
-//! together). Then the column pointers, the row indices and the values,
+//! together); a line that does not fit the widths but whose numbers are
+//! apart by blanks is read by its blanks (SciPy's `hb_write` declares
+//! `(3E25.16)` and writes its values 24 characters wide). Then the column pointers, the row indices and the values,
 //! each section starting on a new line; a right-hand side after the values
 //! (HBMAT writes one by default) is skipped. Pattern-only (`P..`), complex
 //! (`C..`), skew, rectangular and elemental (`..E`) matrices are refused.
@@ -89,47 +91,79 @@ fn section<T>(
             ));
         };
         let line = i + 1;
-        let chars: Vec<char> = l.chars().collect();
         let want = per.min(count - out.len());
-        let mut got = 0;
-        for k in 0..want {
-            let a = k * width;
-            if a >= chars.len() {
-                break;
-            }
-            let field: String = chars[a..(a + width).min(chars.len())].iter().collect();
-            if field.trim().is_empty() {
-                if chars[a..].iter().all(|c| c.is_whitespace()) {
-                    break;
+        // every line but the last of a section is full; a line that does not
+        // fit the widths but holds its numbers apart by blanks is read by
+        // its blanks (SciPy's hb_write writes its E25.16 values 24 wide)
+        let values = match by_width(l, line, want, per, width, what, &read) {
+            Ok(v) if v.len() == want => v,
+            first => {
+                let tokens: Vec<&str> = l.split_whitespace().collect();
+                match tokens.iter().map(|t| read(t)).collect::<Option<Vec<T>>>() {
+                    Some(v) if v.len() == want => v,
+                    _ => {
+                        return Err(match first {
+                            Err(e) => e,
+                            Ok(v) if v.is_empty() => format!(
+                                "line {line}: blank line where the {what} should be ({} of {count} read)",
+                                out.len()
+                            ),
+                            Ok(v) => format!(
+                                "line {line}: {} of the {want} {what} expected on the line (the format gives {per} per line, {width} characters each)",
+                                v.len()
+                            ),
+                        })
+                    }
                 }
-                return Err(format!(
-                    "line {line}: blank field {} among the {what} (fields of {width} characters)",
-                    k + 1
-                ));
             }
-            let v = read(field.trim()).ok_or_else(|| {
-                format!(
-                    "line {line}: '{}' is not one of the {what} (fields of {width} characters)",
-                    field.trim()
-                )
-            })?;
-            out.push((v, line));
-            got += 1;
-        }
-        if chars.len() > want * width && !chars[want * width..].iter().all(|c| c.is_whitespace()) {
-            return Err(format!(
-                "line {line}: more than {want} {what} on the line (the format gives {per} per line, {width} characters each)"
-            ));
-        }
-        if got == 0 {
-            return Err(format!(
-                "line {line}: blank line where the {what} should be ({} of {count} read)",
-                out.len()
-            ));
-        }
+        };
+        out.extend(values.into_iter().map(|v| (v, line)));
         i += 1;
     }
     Ok((out, i))
+}
+
+/// The `want` numbers of one line in fields of `width` (fewer if the line
+/// ends early).
+fn by_width<T>(
+    l: &str,
+    line: usize,
+    want: usize,
+    per: usize,
+    width: usize,
+    what: &str,
+    read: &impl Fn(&str) -> Option<T>,
+) -> Result<Vec<T>, String> {
+    let chars: Vec<char> = l.chars().collect();
+    let mut out = Vec::new();
+    for k in 0..want {
+        let a = k * width;
+        if a >= chars.len() {
+            break;
+        }
+        let field: String = chars[a..(a + width).min(chars.len())].iter().collect();
+        if field.trim().is_empty() {
+            if chars[a..].iter().all(|c| c.is_whitespace()) {
+                break;
+            }
+            return Err(format!(
+                "line {line}: blank field {} among the {what} (fields of {width} characters)",
+                k + 1
+            ));
+        }
+        out.push(read(field.trim()).ok_or_else(|| {
+            format!(
+                "line {line}: '{}' is not one of the {what} (fields of {width} characters)",
+                field.trim()
+            )
+        })?);
+    }
+    if chars.len() > want * width && !chars[want * width..].iter().all(|c| c.is_whitespace()) {
+        return Err(format!(
+            "line {line}: more than {want} {what} on the line (the format gives {per} per line, {width} characters each)"
+        ));
+    }
+    Ok(out)
 }
 
 fn index(s: &str) -> Option<usize> {
@@ -567,7 +601,7 @@ RUA 2 2 3 0
             ),
             (
                 with(2, "RSA 5 5 10 0"),
-                "line 8: more than 1 row indices on the line",
+                "line 7: 1 of the 2 row indices expected on the line",
             ),
             (
                 cut(9),
@@ -575,11 +609,18 @@ RUA 2 2 3 0
             ),
             (
                 with(2, "RSA 500 500 9 0"),
-                "line 8: '.0000' is not one of the column pointers",
+                "line 5: 6 of the 8 column pointers expected on the line",
             ),
             (
                 with(2, "RSA 5000000000000 5000000000000 9 0"),
-                "line 8: '.0000' is not one of the column pointers",
+                "line 5: 6 of the 8 column pointers expected",
+            ),
+            (
+                with(
+                    7,
+                    "  4.000000000000E+00 -1.250000000000E+00  5.000000000000E-01",
+                ),
+                "line 8: 3 of the 4 values expected on the line",
             ),
             (
                 cut(7),
