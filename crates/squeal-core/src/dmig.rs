@@ -9,7 +9,8 @@
 //!
 //! - cards in small field (8-character fields, continuation lines starting
 //!   with `+` or a blank), large field (`DMIG*`, 16-character fields,
-//!   continuation lines starting with `*`) and free field (comma-separated);
+//!   continuation lines starting with `*`) and free field (comma-separated;
+//!   or apart by blanks, `DMIG K 1 2 1 2 29988.`, as ANSYS's `*DMAT` reads);
 //!   `$` starts a comment; columns 73–80 (field 10: continuation marker or
 //!   punch sequence number) are ignored, except that a marker starting with
 //!   `+` or `*` must be followed by a continuation line;
@@ -59,12 +60,34 @@ impl Card {
     }
 }
 
+/// Is field 1 that of a large-field line (`DMIG*`, or `*` continuing)?
+fn is_large(field1: &str) -> bool {
+    field1.starts_with('*') || field1.ends_with('*')
+}
+
+/// One line of a card with its fields apart by blanks (`DMIG K 1 2 1 2
+/// 29988.`, as ANSYS's `*DMAT` import takes): field 1 (empty on a
+/// continuation line without a marker) and the data fields.
+fn split_blanks(body: &str, first: bool) -> (String, Vec<String>) {
+    let mut tokens: Vec<String> = body.split_whitespace().map(str::to_string).collect();
+    let marker = !tokens.is_empty()
+        && (first || (tokens[0].starts_with(['+', '*']) && fortran_real(&tokens[0]).is_none()));
+    let field1 = if marker {
+        tokens.remove(0)
+    } else {
+        String::new()
+    };
+    let nominal = if is_large(&field1) { 4 } else { 8 };
+    tokens.resize(tokens.len().max(nominal), String::new());
+    (field1, tokens)
+}
+
 /// One line split into field 1, the data fields and field 10.
 fn split_line(body: &str) -> (String, Vec<String>, String) {
     if body.contains(',') {
         let mut tokens: Vec<String> = body.split(',').map(|t| t.trim().to_string()).collect();
         let field1 = tokens.remove(0);
-        let nominal = if field1.ends_with('*') { 4 } else { 8 };
+        let nominal = if is_large(&field1) { 4 } else { 8 };
         let mut marker = String::new();
         if tokens.len() > nominal && fortran_real(&tokens[nominal]).is_none() {
             marker = tokens.remove(nominal);
@@ -89,11 +112,7 @@ fn split_line(body: &str) -> (String, Vec<String>, String) {
             .to_string()
     };
     let field1 = cut(0, 8);
-    let (width, nominal) = if field1.ends_with('*') {
-        (16, 4)
-    } else {
-        (8, 8)
-    };
+    let (width, nominal) = if is_large(&field1) { (16, 4) } else { (8, 8) };
     let data = (0..nominal)
         .map(|k| cut(8 + k * width, 8 + (k + 1) * width))
         .collect();
@@ -105,6 +124,7 @@ fn cards(text: &str) -> Result<Vec<Card>, String> {
     let mut out = Vec::new();
     let mut current: Option<Card> = None;
     let mut pending: Option<(usize, String)> = None;
+    let mut blanks = false;
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
         let body = raw.find('$').map_or(raw, |k| &raw[..k]);
@@ -119,9 +139,16 @@ fn cards(text: &str) -> Result<Vec<Card>, String> {
                 ));
             }
         }
-        let (field1, data, marker) = split_line(body);
+        let (mut field1, mut data, marker) = split_line(body);
         if new_card {
             out.extend(current.take());
+            let first = body.split_whitespace().next().unwrap_or("");
+            blanks = !body.contains(',')
+                && !matches!(field1.to_ascii_uppercase().as_str(), "DMIG" | "DMIG*")
+                && matches!(first.to_ascii_uppercase().as_str(), "DMIG" | "DMIG*");
+            if blanks {
+                (field1, data) = split_blanks(body, true);
+            }
             let name = field1.to_ascii_uppercase();
             if name == "ENDDATA" {
                 break;
@@ -135,6 +162,9 @@ fn cards(text: &str) -> Result<Vec<Card>, String> {
             }
         }
         if let Some(card) = current.as_mut() {
+            if blanks && !new_card {
+                data = split_blanks(body, false).1;
+            }
             card.last = line;
             card.fields
                 .extend(data.into_iter().map(|text| Field { text, line }));
@@ -578,6 +608,29 @@ DMIG,STIF,28,1,123,3,6.+7
             vec![(1, 0, 3e5), (2, 0, 2.5e10), (4, 3, 6e7)]
         );
         assert!(!m.symmetric);
+    }
+
+    #[test]
+    fn fields_apart_by_blanks_and_marked_large_continuations() {
+        // ANSYS *DMAT's "free field with blank separators" example, with a header
+        let text =
+            "DMIG stiff 0 6 2\nDMIG stiff 1 2 1 2 29988.\n1 6 149940. 2 2 -29988.\n  2 6 149940.\n";
+        let m = &parse(text).unwrap()[0];
+        assert_eq!(m.name, "stiff");
+        assert_eq!(m.labels.as_ref().unwrap(), &["1_2", "1_6", "2_2", "2_6"]);
+        assert_eq!(m.triplets.entries.len(), 7);
+        assert_eq!(m.triplets.entries[0], (0, 0, 29988.0));
+        assert_eq!(m.triplets.entries[1], (1, 0, 149940.0));
+        assert_eq!(m.triplets.entries[3], (2, 0, -29988.0));
+        // a large-field continuation with a named marker, and a tab
+        let text = format!(
+            "DMIG\tK\t0\t6\t2\n{:<72}*K1\n{:<72}\n",
+            "DMIG*   K                              5               3",
+            "*K1                    5               3-2.261491337E+08"
+        );
+        let m = &parse(&text).unwrap()[0];
+        assert_eq!(m.labels.as_ref().unwrap(), &["5_3"]);
+        assert_eq!(m.triplets.entries, vec![(0, 0, -2.261491337e8)]);
     }
 
     #[test]
