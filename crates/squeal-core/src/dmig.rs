@@ -27,7 +27,8 @@
 //!
 //! Dofs are named `<G>_<C>` (a scalar point `<G>_0`) in order of first
 //! appearance: each column's `GJ_CJ`, then its rows. A file holds several
-//! matrices; [`parse`] returns all, in the order their names first appear.
+//! matrices; [`parse`] returns all it can read, in the order their names
+//! first appear, and [`parse_named`] the one of a given name.
 //! `NCOL` is used only by rectangular forms and is ignored. Other cards
 //! (`GRID`, `BEGIN BULK`, …) are skipped; reading stops at `ENDDATA`.
 //! Pure: takes text; errors are one line, `line N: what is wrong`.
@@ -190,9 +191,49 @@ struct Gathered {
 }
 
 /// Parse every DMIG matrix of a Nastran bulk-data or punch text (see the
-/// module docs), in the order their names first appear. Errors name the
-/// line and what is wrong.
+/// module docs), in the order their names first appear. A matrix of a form
+/// or type squeal does not read (rectangular forms 2 and 9, complex types 3
+/// and 4) is left out, as the `VAX` matrix (form 9) that
+/// `PARAM,EXTOUT,DMIGPCH` punches beside `KAAX` and `MAAX`; if no matrix is
+/// left, the first one's reason is the error. Errors name the line and what
+/// is wrong.
 pub fn parse(text: &str) -> Result<Vec<LabelledMatrix>, String> {
+    let mut out = Vec::new();
+    let mut refused = Vec::new();
+    for g in gather(text)? {
+        match matrix(g)? {
+            Ok(m) => out.push(m),
+            Err(why) => refused.push(why),
+        }
+    }
+    if out.is_empty() {
+        return Err(refused.swap_remove(0));
+    }
+    Ok(out)
+}
+
+/// Parse the DMIG matrix `name` (any letter case) of a Nastran bulk-data or
+/// punch text: as [`parse`], but a form or type squeal does not read is an
+/// error, and so is a name the file does not have (the message lists the
+/// names it has).
+pub fn parse_named(text: &str, name: &str) -> Result<LabelledMatrix, String> {
+    let gathered = gather(text)?;
+    let names: Vec<String> = gathered.iter().map(|g| g.name.clone()).collect();
+    let g = gathered
+        .into_iter()
+        .find(|g| g.name.eq_ignore_ascii_case(name))
+        .ok_or_else(|| {
+            format!(
+                "no DMIG matrix {name} in the file (it has {})",
+                names.join(", ")
+            )
+        })?;
+    matrix(g)?
+}
+
+/// The DMIG cards of a text gathered by matrix name, in order of first
+/// appearance (at least one).
+fn gather(text: &str) -> Result<Vec<Gathered>, String> {
     let mut gathered: Vec<Gathered> = Vec::new();
     let mut by_name: HashMap<String, usize> = HashMap::new();
     for card in cards(text)? {
@@ -227,11 +268,13 @@ pub fn parse(text: &str) -> Result<Vec<LabelledMatrix>, String> {
     if gathered.is_empty() {
         return Err("no DMIG card in the file".into());
     }
-    gathered.into_iter().map(matrix).collect()
+    Ok(gathered)
 }
 
-/// Read one gathered matrix.
-fn matrix(g: Gathered) -> Result<LabelledMatrix, String> {
+/// Read one gathered matrix: `Err` for a bad file, `Ok(Err)` for a form
+/// or type squeal does not read.
+#[allow(clippy::type_complexity)]
+fn matrix(g: Gathered) -> Result<Result<LabelledMatrix, String>, String> {
     let name = g.name;
     let Some(header) = g.header else {
         return Err(format!(
@@ -260,10 +303,10 @@ fn matrix(g: Gathered) -> Result<LabelledMatrix, String> {
         1 => Symmetry::General,
         6 => Symmetry::Declared,
         2 | 9 => {
-            return Err(format!(
+            return Ok(Err(format!(
                 "line {}: DMIG {name}: form IFO={ifo} (rectangular) is not supported: squeal reads square matrices, form 1 (square) or 6 (symmetric)",
                 header.line_of(2)
-            ))
+            )))
         }
         _ => {
             return Err(format!(
@@ -276,10 +319,10 @@ fn matrix(g: Gathered) -> Result<LabelledMatrix, String> {
     match tin {
         1 | 2 => {}
         3 | 4 => {
-            return Err(format!(
+            return Ok(Err(format!(
                 "line {}: DMIG {name}: complex matrix (TIN={tin}) is not supported: a mass, stiffness or damping matrix is real (TIN 1 or 2)",
                 header.line_of(3)
-            ))
+            )))
         }
         _ => {
             return Err(format!(
@@ -367,13 +410,13 @@ fn matrix(g: Gathered) -> Result<LabelledMatrix, String> {
     let n = labels.names.len();
     let names = &labels.names;
     let (triplets, symmetric) = entries.finish(n, symmetry, &|i| names[i].clone())?;
-    Ok(LabelledMatrix {
+    Ok(Ok(LabelledMatrix {
         name,
         format: "dmig",
         labels: Some(labels.names),
         triplets,
         symmetric,
-    })
+    }))
 }
 
 #[cfg(test)]
@@ -631,6 +674,74 @@ DMIG,STIF,28,1,123,3,6.+7
         let m = &parse(&text).unwrap()[0];
         assert_eq!(m.labels.as_ref().unwrap(), &["5_3"]);
         assert_eq!(m.triplets.entries, vec![(0, 0, -2.261491337e8)]);
+    }
+
+    /// The layout of an MSC Nastran `PARAM,EXTOUT,DMIGPCH` punch file: the
+    /// upper triangle column by column, `NCOL` in field 9 of the header,
+    /// and a form-9 `VAX` matrix after `KAAX` and `MAAX`.
+    const PUNCH: &str = "\
+DMIG    KAAX           0       6       2       0                       4
+DMIG*   KAAX                           1               3
+*                      1               3 2.000000000D+06
+DMIG*   KAAX                           1               4
+*                      1               3 5.000000000D+05
+*                      1               4 1.000000000D+06
+DMIG*   KAAX                           2               3
+*                      1               3-2.000000000D+06
+*                      2               3 4.000000000D+06
+DMIG*   KAAX                           2               4
+*                      1               4 2.500000000D+05
+*                      2               4 3.000000000D+06
+DMIG    MAAX           0       6       2       0                       4
+DMIG*   MAAX                           1               3
+*                      1               3 1.250000000D+00
+DMIG*   MAAX                           2               3
+*                      2               3 2.500000000D+00
+DMIG    VAX            0       9       2       0                       1
+DMIG*   VAX                            1               0
+*                      1               3 1.000000000D+00
+*                      1               4 1.000000000D+00
+";
+
+    #[test]
+    fn punch_file_with_a_rectangular_vax_and_named_matrices() {
+        let m = parse(PUNCH).unwrap();
+        assert_eq!(m.len(), 2);
+        let k = &m[0];
+        assert_eq!((k.name.as_str(), m[1].name.as_str()), ("KAAX", "MAAX"));
+        assert_eq!(k.labels.as_ref().unwrap(), &["1_3", "1_4", "2_3", "2_4"]);
+        assert!(k.symmetric);
+        assert_eq!(
+            k.triplets.entries,
+            vec![
+                (0, 0, 2e6),
+                (0, 1, 5e5),
+                (1, 0, 5e5),
+                (1, 1, 1e6),
+                (0, 2, -2e6),
+                (2, 0, -2e6),
+                (2, 2, 4e6),
+                (1, 3, 2.5e5),
+                (3, 1, 2.5e5),
+                (3, 3, 3e6)
+            ]
+        );
+        // MAAX names only the dofs with mass
+        assert_eq!(m[1].labels.as_ref().unwrap(), &["1_3", "2_3"]);
+        assert_eq!(m[1].triplets.entries, vec![(0, 0, 1.25), (1, 1, 2.5)]);
+        assert_eq!(parse_named(PUNCH, "maax").unwrap(), m[1]);
+        assert_eq!(
+            parse_named(PUNCH, "VAX").unwrap_err(),
+            "line 18: DMIG VAX: form IFO=9 (rectangular) is not supported: squeal reads square matrices, form 1 (square) or 6 (symmetric)"
+        );
+        assert_eq!(
+            parse_named(PUNCH, "KGG").unwrap_err(),
+            "no DMIG matrix KGG in the file (it has KAAX, MAAX, VAX)"
+        );
+        let only_vax = &PUNCH[PUNCH.find("DMIG    VAX").unwrap()..];
+        assert!(parse(only_vax)
+            .unwrap_err()
+            .starts_with("line 1: DMIG VAX: form IFO=9"));
     }
 
     #[test]
