@@ -12,13 +12,17 @@
 //!   size is the largest number, at most 64 per entry + 64 so that a stray
 //!   number cannot make a huge matrix).
 //!
-//! The format is recognised by the number of fields (5 or 3) of the first
-//! data line; every line must have the same. Blank lines and `**` comments
-//! are skipped; a keyword line (`*USER ELEMENT`, `*MATRIX`, … as in element
-//! matrix output) is refused: only assembled matrices are read. A matrix
+//! Fields are apart by commas (or, without commas, by blanks). The format
+//! is recognised by the number of fields (5 or 3) of the first data line;
+//! every line must have the same. Blank lines and `**` comments
+//! are skipped; a keyword line (`*CLOAD` of a load file, `*USER ELEMENT` of
+//! element matrix output) is refused: only assembled matrices are read. A matrix
 //! given by one triangle (upper or lower) is symmetric and mirrored; one
 //! given by both is symmetric if every entry equals its mirror, and is read
 //! as given (unsymmetric) otherwise. An entry given twice is an error.
+//! Abaqus writes the lower triangle of a symmetric matrix, 16 significant
+//! digits, and `1e36` on the diagonal of a constrained dof (kept as
+//! written: the caller decides what a constrained dof is).
 //! Pure: takes text; errors are one line, `line N: what is wrong`.
 
 use crate::labelled::{fortran_real, Entries, LabelledMatrix, Labels, Symmetry};
@@ -37,10 +41,14 @@ pub fn parse(text: &str) -> Result<LabelledMatrix, String> {
         }
         if t.starts_with('*') {
             return Err(format!(
-                "line {line}: keyword line '{t}': squeal reads the assembled matrices of *MATRIX GENERATE with *MATRIX OUTPUT (FORMAT=MATRIX INPUT or COORDINATE), not element matrix output"
+                "line {line}: keyword line '{t}': squeal reads the assembled matrices that *MATRIX GENERATE with *MATRIX OUTPUT writes (FORMAT=MATRIX INPUT or COORDINATE), not loads (*CLOAD) or element matrices (*USER ELEMENT)"
             ));
         }
-        let mut w: Vec<&str> = t.split(',').map(str::trim).collect();
+        let mut w: Vec<&str> = if t.contains(',') {
+            t.split(',').map(str::trim).collect()
+        } else {
+            t.split_whitespace().collect()
+        };
         if w.len() > 1 && w.last() == Some(&"") {
             w.pop();
         }
@@ -223,6 +231,43 @@ mod tests {
         );
     }
 
+    /// The layout of a file written by Abaqus (`*MATRIX OUTPUT, STIFFNESS`):
+    /// the lower triangle in Abaqus's equation order (an internal node −1
+    /// first), 16 digits, `1e36` on the diagonal of constrained dofs.
+    #[test]
+    fn abaqus_layout_with_an_internal_node_and_constrained_dofs() {
+        let text = "\
+-1,1, -1,1,  4.000000000000000e+01
+-1,2, -1,1, -1.000000000000000e+01
+1,1, -1,1,  2.000000000000000e+01
+-1,2, -1,2,  3.000000000000000e+01
+1,1, -1,2,  2.500000000000000e+01
+1,1, 1,1,  1.000000000000000e+36
+2,1, 1,1, -3.000000000000000e+02
+2,1, 2,1,  3.000000000000000e+02
+";
+        let m = parse(text).unwrap();
+        assert!(m.symmetric);
+        assert_eq!(m.labels.as_ref().unwrap(), &["m1_1", "m1_2", "1_1", "2_1"]);
+        let d = dense_by(&m, &["m1_1", "m1_2", "1_1", "2_1"]);
+        assert_eq!(
+            d,
+            vec![
+                vec![40.0, -10.0, 20.0, 0.0],
+                vec![-10.0, 30.0, 25.0, 0.0],
+                vec![20.0, 25.0, 1e36, -300.0],
+                vec![0.0, 0.0, -300.0, 300.0]
+            ]
+        );
+        // FORMAT=COORDINATE apart by blanks
+        let m = parse("1 1  2.0e+00\n2 1 -1.0e+00\n2 2  2.0e+00\n").unwrap();
+        assert_eq!(m.format, "abaqus-coordinate");
+        assert_eq!(
+            m.triplets.entries,
+            vec![(0, 0, 2.0), (1, 0, -1.0), (0, 1, -1.0), (1, 1, 2.0)]
+        );
+    }
+
     #[test]
     fn bad_files_name_the_line() {
         for (text, needle) in [
@@ -231,6 +276,10 @@ mod tests {
             (
                 "*USER ELEMENT, NODES=2\n",
                 "line 1: keyword line '*USER ELEMENT, NODES=2'",
+            ),
+            (
+                "** Assembled nodal loads\n*CLOAD, REAL\n2,3,  5.4e+04\n",
+                "line 2: keyword line '*CLOAD, REAL'",
             ),
             (
                 "1,1,1,1,2.0\n1,2,3.0\n",
