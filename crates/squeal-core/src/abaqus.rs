@@ -18,8 +18,11 @@
 //! are skipped; a keyword line (`*CLOAD` of a load file, `*USER ELEMENT` of
 //! element matrix output) is refused: only assembled matrices are read. A matrix
 //! given by one triangle (upper or lower) is symmetric and mirrored; one
-//! given by both is symmetric if every entry equals its mirror, and is read
-//! as given (unsymmetric) otherwise. An entry given twice is an error.
+//! given by both triangles is read as given (an entry without its mirror,
+//! such as a friction coupling, stays one-sided) and is symmetric if every
+//! entry equals its mirror; a file giving most off-diagonal entries in one
+//! triangle but some with their mirror is refused. An entry given twice is
+//! an error.
 //! Abaqus writes the lower triangle of a symmetric matrix, 16 significant
 //! digits, and `1e36` on the diagonal of a constrained dof (kept as
 //! written: the caller decides what a constrained dof is).
@@ -276,6 +279,10 @@ mod tests {
             (
                 "*USER ELEMENT, NODES=2\n",
                 "line 1: keyword line '*USER ELEMENT, NODES=2'",
+            ),
+            (
+                "1,1,2,1,1.0\n2,1,1,1,1.0\n3,1,1,1,1.0\n4,1,1,1,1.0\n5,1,1,1,1.0\n",
+                "line 2: entry (row 1_1, column 2_1) is given with its mirror (line 1), but most off-diagonal entries (3 of 5)",
             ),
             (
                 "** Assembled nodal loads\n*CLOAD, REAL\n2,3,  5.4e+04\n",

@@ -88,9 +88,11 @@ pub(crate) enum Symmetry {
     /// Declared symmetric, one triangle given (DMIG form 6, HB `RSA`):
     /// mirrored; an entry given in both triangles must have equal values.
     Declared,
-    /// Decide from the entries (Abaqus): if every pair given both ways
-    /// agrees, symmetric (entries given one way mirrored); if any pair
-    /// disagrees, unsymmetric, as given.
+    /// Decide from the entries (Abaqus): no off-diagonal entry given with
+    /// its mirror: one triangle, symmetric, mirrored; some given both ways:
+    /// both triangles, as given (an unsymmetric matrix may have one-sided
+    /// entries, as friction couplings), symmetric if every entry equals
+    /// its mirror; an error if most entries are one-sided but some are not.
     Detect,
 }
 
@@ -187,14 +189,37 @@ impl Entries {
                 }
                 true
             }
-            Symmetry::Detect => self
-                .list
-                .iter()
-                .all(|e| mirror(e).is_none_or(|m| m.2 == e.2)),
+            Symmetry::Detect => {
+                let off: Vec<_> = self.list.iter().filter(|e| e.0 != e.1).collect();
+                let paired = off.iter().filter(|e| mirror(e).is_some()).count();
+                let single = off.len() - paired;
+                if paired == 0 {
+                    true
+                } else if single > paired {
+                    let e = off.iter().find(|e| mirror(e).is_some()).unwrap();
+                    let m = mirror(e).unwrap();
+                    return Err(format!(
+                        "line {}: entry (row {}, column {}) is given with its mirror (line {}), but most off-diagonal entries ({single} of {}) are given in one triangle only: give one triangle (symmetric) or both (any matrix)",
+                        e.3.max(m.3),
+                        name(e.0),
+                        name(e.1),
+                        e.3.min(m.3),
+                        off.len()
+                    ));
+                } else {
+                    single == 0 && off.iter().all(|e| mirror(e).is_some_and(|m| m.2 == e.2))
+                }
+            }
+        };
+        // one triangle given: mirror it; both given: as they are
+        let mirror_singles = match mode {
+            Symmetry::General => false,
+            Symmetry::Declared => true,
+            Symmetry::Detect => !self.list.iter().any(|e| e.0 != e.1 && mirror(e).is_some()),
         };
         for &(r, c, v, _) in &self.list {
             t.entries.push((r, c, v));
-            if symmetric && r != c && !self.at.contains_key(&(c, r)) {
+            if mirror_singles && r != c && !self.at.contains_key(&(c, r)) {
                 t.entries.push((c, r, v));
             }
         }
@@ -369,6 +394,24 @@ pub(crate) mod tests {
         let (t, s) = e.finish(3, Symmetry::Detect, &nm).unwrap();
         assert!(!s);
         assert_eq!(t.entries.len(), 4);
+        // both triangles, equal, and a one-sided entry (a friction
+        // coupling): unsymmetric, as given, not mirrored
+        let mut e = Entries::default();
+        e.add(1, 0, -1.0, 3, &nm).unwrap();
+        e.add(0, 1, -1.0, 4, &nm).unwrap();
+        e.add(2, 1, 0.3, 5, &nm).unwrap();
+        let (t, s) = e.finish(3, Symmetry::Detect, &nm).unwrap();
+        assert!(!s);
+        assert_eq!(t.entries, vec![(1, 0, -1.0), (0, 1, -1.0), (2, 1, 0.3)]);
+        // mostly one triangle, one pair both ways: refused
+        let mut e = Entries::default();
+        e.add(1, 0, -1.0, 3, &nm).unwrap();
+        e.add(2, 0, -1.0, 4, &nm).unwrap();
+        e.add(2, 1, -1.0, 5, &nm).unwrap();
+        e.add(3, 1, -1.0, 6, &nm).unwrap();
+        e.add(0, 1, -1.0, 7, &nm).unwrap();
+        let err = e.finish(4, Symmetry::Detect, &nm).unwrap_err();
+        assert_eq!(err, "line 7: entry (row d1, column d0) is given with its mirror (line 3), but most off-diagonal entries (3 of 5) are given in one triangle only: give one triangle (symmetric) or both (any matrix)");
         // duplicates
         let mut e = Entries::default();
         e.add(1, 0, -1.0, 3, &nm).unwrap();
