@@ -92,6 +92,12 @@ fn split_line(body: &str) -> (String, Vec<String>, String) {
         let mut marker = String::new();
         if tokens.len() > nominal && fortran_real(&tokens[nominal]).is_none() {
             marker = tokens.remove(nominal);
+        } else if tokens
+            .last()
+            .is_some_and(|t| t.starts_with(['+', '*']) && fortran_real(t).is_none())
+        {
+            // a continuation marker after fewer than 8 fields
+            marker = tokens.pop().unwrap_or_default();
         }
         tokens.resize(tokens.len().max(nominal), String::new());
         return (field1, tokens, marker);
@@ -637,8 +643,8 @@ DMIG    STIF    9       1               9       1       1.
         // OptiStruct: G1 in field 5 (the Altair QRG's example, made square)
         let text = "\
 DMIG,STIF,0,1,2
-DMIG,STIF,27,1,120,3,3.+5,,
-,120,4,2.5+10
+DMIG,STIF,27,1,120,3,3.+5,+C
++C,120,4,2.5+10
 DMIG,STIF,28,1,123,3,6.+7
 ";
         let m = &parse(text).unwrap()[0];
