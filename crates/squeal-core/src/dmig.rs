@@ -34,27 +34,28 @@
 //! Pure: takes text; errors are one line, `line N: what is wrong`.
 
 use crate::labelled::{fortran_real, is_integer, Entries, LabelledMatrix, Labels, Symmetry};
+use std::borrow::Cow;
 use std::collections::HashMap;
 
 /// A field of a card: its text (trimmed; empty if blank) and 1-based line.
 #[derive(Debug, Clone)]
-struct Field {
-    text: String,
+struct Field<'a> {
+    text: Cow<'a, str>,
     line: usize,
 }
 
 /// A DMIG card: fields 2… in order (field 1 and the continuation markers
 /// dropped), each line's fields padded to its nominal count (8, large 4).
 #[derive(Debug, Clone)]
-struct Card {
+struct Card<'a> {
     first: usize,
     last: usize,
-    fields: Vec<Field>,
+    fields: Vec<Field<'a>>,
 }
 
-impl Card {
+impl Card<'_> {
     fn field(&self, k: usize) -> &str {
-        self.fields.get(k).map_or("", |f| f.text.as_str())
+        self.fields.get(k).map_or("", |f| &f.text)
     }
     fn line_of(&self, k: usize) -> usize {
         self.fields.get(k).map_or(self.first, |f| f.line)
@@ -69,27 +70,30 @@ fn is_large(field1: &str) -> bool {
 /// One line of a card with its fields apart by blanks (`DMIG K 1 2 1 2
 /// 29988.`, as ANSYS's `*DMAT` import takes): field 1 (empty on a
 /// continuation line without a marker) and the data fields.
-fn split_blanks(body: &str, first: bool) -> (String, Vec<String>) {
-    let mut tokens: Vec<String> = body.split_whitespace().map(str::to_string).collect();
+fn split_blanks(body: &str, first: bool) -> (Cow<'_, str>, Vec<Cow<'_, str>>) {
+    let mut tokens: Vec<Cow<str>> = body.split_whitespace().map(Cow::Borrowed).collect();
     let marker = !tokens.is_empty()
         && (first || (tokens[0].starts_with(['+', '*']) && fortran_real(&tokens[0]).is_none()));
     let field1 = if marker {
         tokens.remove(0)
     } else {
-        String::new()
+        Cow::Borrowed("")
     };
     let nominal = if is_large(&field1) { 4 } else { 8 };
-    tokens.resize(tokens.len().max(nominal), String::new());
+    tokens.resize(tokens.len().max(nominal), Cow::Borrowed(""));
     (field1, tokens)
 }
 
+/// A line's fields: field 1, the data fields and field 10.
+type Split<'a> = (Cow<'a, str>, Vec<Cow<'a, str>>, Cow<'a, str>);
+
 /// One line split into field 1, the data fields and field 10.
-fn split_line(body: &str) -> (String, Vec<String>, String) {
+fn split_line(body: &str) -> Split<'_> {
     if body.contains(',') {
-        let mut tokens: Vec<String> = body.split(',').map(|t| t.trim().to_string()).collect();
+        let mut tokens: Vec<Cow<str>> = body.split(',').map(|t| Cow::Borrowed(t.trim())).collect();
         let field1 = tokens.remove(0);
         let nominal = if is_large(&field1) { 4 } else { 8 };
-        let mut marker = String::new();
+        let mut marker = Cow::Borrowed("");
         if tokens.len() > nominal && fortran_real(&tokens[nominal]).is_none() {
             marker = tokens.remove(nominal);
         } else if tokens
@@ -99,8 +103,24 @@ fn split_line(body: &str) -> (String, Vec<String>, String) {
             // a continuation marker after fewer than 8 fields
             marker = tokens.pop().unwrap_or_default();
         }
-        tokens.resize(tokens.len().max(nominal), String::new());
+        tokens.resize(tokens.len().max(nominal), Cow::Borrowed(""));
         return (field1, tokens, marker);
+    }
+    if body.is_ascii() && !body.contains('\t') {
+        // fixed field, the common case: fields are slices of the line
+        let cut = |a: usize, b: usize| -> Cow<str> {
+            Cow::Borrowed(
+                body.get(a.min(body.len())..b.min(body.len()))
+                    .unwrap_or("")
+                    .trim(),
+            )
+        };
+        let field1 = cut(0, 8);
+        let (width, nominal) = if is_large(&field1) { (16, 4) } else { (8, 8) };
+        let data = (0..nominal)
+            .map(|k| cut(8 + k * width, 8 + (k + 1) * width))
+            .collect();
+        return (field1, data, cut(72, 80));
     }
     // fixed field: expand tabs to 8-column stops
     let mut chars: Vec<char> = Vec::with_capacity(body.len());
@@ -111,12 +131,14 @@ fn split_line(body: &str) -> (String, Vec<String>, String) {
             chars.push(ch);
         }
     }
-    let cut = |a: usize, b: usize| -> String {
-        chars[a.min(chars.len())..b.min(chars.len())]
-            .iter()
-            .collect::<String>()
-            .trim()
-            .to_string()
+    let cut = |a: usize, b: usize| -> Cow<str> {
+        Cow::Owned(
+            chars[a.min(chars.len())..b.min(chars.len())]
+                .iter()
+                .collect::<String>()
+                .trim()
+                .to_string(),
+        )
     };
     let field1 = cut(0, 8);
     let (width, nominal) = if is_large(&field1) { (16, 4) } else { (8, 8) };
@@ -127,7 +149,7 @@ fn split_line(body: &str) -> (String, Vec<String>, String) {
 }
 
 /// The DMIG cards of a bulk-data or punch text.
-fn cards(text: &str) -> Result<Vec<Card>, String> {
+fn cards(text: &str) -> Result<Vec<Card<'_>>, String> {
     let mut out = Vec::new();
     let mut current: Option<Card> = None;
     let mut pending: Option<(usize, String)> = None;
@@ -176,7 +198,7 @@ fn cards(text: &str) -> Result<Vec<Card>, String> {
             card.fields
                 .extend(data.into_iter().map(|text| Field { text, line }));
             if marker.starts_with(['+', '*']) {
-                pending = Some((line, marker));
+                pending = Some((line, marker.to_string()));
             }
         }
     }
@@ -190,10 +212,10 @@ fn cards(text: &str) -> Result<Vec<Card>, String> {
 }
 
 /// A matrix being gathered: its header card and its column cards.
-struct Gathered {
+struct Gathered<'a> {
     name: String,
-    header: Option<Card>,
-    columns: Vec<Card>,
+    header: Option<Card<'a>>,
+    columns: Vec<Card<'a>>,
 }
 
 /// Parse every DMIG matrix of a Nastran bulk-data or punch text (see the
@@ -239,7 +261,7 @@ pub fn parse_named(text: &str, name: &str) -> Result<LabelledMatrix, String> {
 
 /// The DMIG cards of a text gathered by matrix name, in order of first
 /// appearance (at least one).
-fn gather(text: &str) -> Result<Vec<Gathered>, String> {
+fn gather(text: &str) -> Result<Vec<Gathered<'_>>, String> {
     let mut gathered: Vec<Gathered> = Vec::new();
     let mut by_name: HashMap<String, usize> = HashMap::new();
     for card in cards(text)? {
@@ -338,6 +360,12 @@ fn matrix(g: Gathered) -> Result<Result<LabelledMatrix, String>, String> {
         }
     }
     let mut labels = Labels::default();
+    // (point, component) → index, so that a label is formatted once per dof
+    let mut ids: HashMap<(u64, u64), usize> = HashMap::new();
+    let mut dof = |g: u64, c: u64, labels: &mut Labels| {
+        *ids.entry((g, c))
+            .or_insert_with(|| labels.get(format!("{g}_{c}")))
+    };
     let mut entries = Entries::default();
     for card in &g.columns {
         let point = |k: usize| -> Result<u64, String> {
@@ -363,7 +391,7 @@ fn matrix(g: Gathered) -> Result<Result<LabelledMatrix, String>, String> {
         };
         let gj = point(1)?;
         let cj = component(card.field(2), card.line_of(2))?;
-        let col = labels.get(format!("{gj}_{cj}"));
+        let col = dof(gj, cj, &mut labels);
         let mut stream = card.fields.iter().skip(3).filter(|f| !f.text.is_empty());
         let mut count = 0;
         while let Some(g) = stream.next() {
@@ -401,7 +429,7 @@ fn matrix(g: Gathered) -> Result<Result<LabelledMatrix, String>, String> {
                     a.line, a.text
                 )
             })?;
-            let row = labels.get(format!("{gi}_{ci}"));
+            let row = dof(gi, ci, &mut labels);
             let names = &labels.names;
             entries.add(row, col, v, a.line, &|i| names[i].clone())?;
             count += 1;
