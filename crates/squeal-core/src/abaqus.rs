@@ -33,6 +33,8 @@ use crate::labelled::{fortran_real, Entries, LabelledMatrix, Labels, Symmetry};
 /// Parse the text of an Abaqus `*MATRIX OUTPUT` file (see the module docs).
 pub fn parse(text: &str) -> Result<LabelledMatrix, String> {
     let mut labels = Labels::default();
+    // (node, dof) → index, so that a label is formatted once per dof
+    let mut ids: std::collections::HashMap<(i64, i64), usize> = Default::default();
     let mut entries = Entries::default();
     let mut fields_per_line: Option<(usize, usize)> = None;
     let mut largest = (0usize, 0usize);
@@ -81,12 +83,13 @@ pub fn parse(text: &str) -> Result<LabelledMatrix, String> {
                     if d < 1 {
                         return Err(format!("line {line}: dof {d} is not a dof number (1, 2, …)"));
                     }
-                    let name = if node < 0 {
-                        format!("m{}_{d}", node.unsigned_abs())
-                    } else {
-                        format!("{node}_{d}")
-                    };
-                    Ok(labels.get(name))
+                    Ok(*ids.entry((node, d)).or_insert_with(|| {
+                        labels.get(if node < 0 {
+                            format!("m{}_{d}", node.unsigned_abs())
+                        } else {
+                            format!("{node}_{d}")
+                        })
+                    }))
                 };
                 (dof(w[0], w[1])?, dof(w[2], w[3])?)
             }
