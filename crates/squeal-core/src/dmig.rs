@@ -779,6 +779,13 @@ DMIG*   VAX                            1               0
     }
 
     #[test]
+    fn a_header_without_columns_is_an_empty_matrix() {
+        let m = &parse("DMIG    E       0       6       2\n").unwrap()[0];
+        assert_eq!((m.name.as_str(), m.triplets.rows), ("E", 0));
+        assert_eq!(m.labels.as_deref(), Some(&[][..]));
+    }
+
+    #[test]
     fn punch_file_with_sequence_numbers() {
         // PARAM,EXTOUT,DMIGPCH style: large field, `$` lines, columns 73–80 numbered
         let body = [

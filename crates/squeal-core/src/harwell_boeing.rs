@@ -545,6 +545,15 @@ RUA 2 2 3 0
     }
 
     #[test]
+    fn empty_columns_and_crlf() {
+        // column 2 has no entries; Windows line ends
+        let text = "t\r\n3 1 1 1\r\nRSA 3 3 2 0\r\n(4I3) (2I3) (2E10.3)\r\n  1  2  2  3\r\n  1  3\r\n 1.000E+00 2.000E+00\r\n";
+        let m = parse(text, None).unwrap();
+        assert_eq!((m.triplets.rows, m.triplets.cols), (3, 3));
+        assert_eq!(m.triplets.entries, vec![(0, 0, 1.0), (2, 2, 2.0)]);
+    }
+
+    #[test]
     fn fortran_formats() {
         for (f, want) in [
             ("(10I8)", Some((10, 8))),
