@@ -168,7 +168,7 @@ fn cards(text: &str) -> Result<Vec<Card<'_>>, String> {
                 ));
             }
         }
-        let (mut field1, mut data, marker) = split_line(body);
+        let (mut field1, mut data, mut marker) = split_line(body);
         if new_card {
             out.extend(current.take());
             let first = body.split_whitespace().next().unwrap_or("");
@@ -177,6 +177,7 @@ fn cards(text: &str) -> Result<Vec<Card<'_>>, String> {
                 && matches!(first.to_ascii_uppercase().as_str(), "DMIG" | "DMIG*");
             if blanks {
                 (field1, data) = split_blanks(body, true);
+                marker = Cow::Borrowed("");
             }
             let name = field1.to_ascii_uppercase();
             if name == "ENDDATA" {
@@ -193,6 +194,7 @@ fn cards(text: &str) -> Result<Vec<Card<'_>>, String> {
         if let Some(card) = current.as_mut() {
             if blanks && !new_card {
                 data = split_blanks(body, false).1;
+                marker = Cow::Borrowed("");
             }
             card.last = line;
             card.fields
@@ -694,6 +696,9 @@ DMIG,STIF,28,1,123,3,6.+7
             "DMIG stiff 0 6 2\nDMIG stiff 1 2 1 2 29988.\n1 6 149940. 2 2 -29988.\n  2 6 149940.\n";
         let m = &parse(text).unwrap()[0];
         assert_eq!(m.name, "stiff");
+        // a long line: column 73 is no continuation marker here
+        let long = format!("{text}DMIG stiff 3 1 3 1 1.0000000000000000 3 2 2.0000000000000000 3 3        +3.0000000000000000\nDMIG stiff 9 1 9 1 1.\n");
+        assert_eq!(parse(&long).unwrap()[0].triplets.entries.len(), 7 + 6);
         assert_eq!(m.labels.as_ref().unwrap(), &["1_2", "1_6", "2_2", "2_6"]);
         assert_eq!(m.triplets.entries.len(), 7);
         assert_eq!(m.triplets.entries[0], (0, 0, 29988.0));
