@@ -34,10 +34,14 @@
 //! assert_eq!(run.stats.event_count(EventKind::Reverse), 0); // too early for stick-slip
 //! ```
 
+pub mod abaqus;
 pub mod cycle;
+pub mod dmig;
 pub mod friction;
+pub mod harwell_boeing;
 pub mod initial;
 pub mod integrate;
+pub mod labelled;
 pub mod matrix_market;
 pub mod model;
 pub mod params;
