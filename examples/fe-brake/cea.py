@@ -13,7 +13,10 @@ solve) and linearises about it:
 the steady state's contact forces and the eigenvalues of
 [[0, I], [-M^-1 K_eff, -M^-1 C_eff]] sorted by growth rate, as JSON.
 
-    python3 cea.py two-pad/brake.toml --set inner.mu_k=0.6 > eig.json
+    python3 cea.py two-pad/brake.toml --set mu=0.6 > eig.json
+
+Element values may be expressions of [params] (evaluated here with Python's
+arithmetic); --set sets a parameter (no dot) or an element key.
 """
 
 import json
@@ -46,6 +49,15 @@ def main():
             raise SystemExit(f"unknown argument {args[0]}")
     with open(path, "rb") as f:
         sc = tomllib.load(f)
+    params = dict(sc.get("params", {}))
+    params.update({k: v for k, v in sets.items() if "." not in k})
+
+    def val(x):
+        """A number, or an expression of [params] (arithmetic only)."""
+        if isinstance(x, str):
+            return float(eval(x.replace("^", "**"), {"__builtins__": {}}, params))
+        return float(x)
+
     base = os.path.dirname(path)
     mats = {k: scipy.io.mmread(os.path.join(base, v)).toarray() for k, v in sc["matrices"].items()}
     dofs = sc["dofs"]
@@ -55,24 +67,24 @@ def main():
     k = mats.get("K", np.zeros((n, n))).copy()
     c = mats.get("C", np.zeros((n, n))).copy()
     for d, mass in sc.get("masses", {}).items():
-        m[index[d], index[d]] += mass
+        m[index[d], index[d]] += val(mass)
     b = np.zeros(n)
     for s in sc.get("spring", []):
         a = comb(s["on"], index, n)
-        k += s["k"] * np.outer(a, a)
-        c += s.get("c", 0.0) * np.outer(a, a)
+        k += val(s["k"]) * np.outer(a, a)
+        c += val(s.get("c", 0.0)) * np.outer(a, a)
     for f in sc.get("force", []):
-        b += f["value"] * comb(f["on"], index, n)
+        b += val(f["value"]) * comb(f["on"], index, n)
     ks, cs = k.copy(), c.copy()
     contacts = []
     for ct in sc.get("contact", []):
         name = ct["name"]
         law = ct.get("friction")
         assert law == "coulomb", "this check handles Coulomb friction only"
-        mu_k = sets.get(f"{name}.mu_k", ct["mu_k"])
-        kc = sets.get(f"{name}.k", ct["k"])
-        cc = sets.get(f"{name}.c", ct.get("c", 0.0))
-        v = ct["V"]
+        mu_k = sets.get(f"{name}.mu_k", val(ct["mu_k"]))
+        kc = sets.get(f"{name}.k", val(ct["k"]))
+        cc = sets.get(f"{name}.c", val(ct.get("c", 0.0)))
+        v = val(ct["V"])
         s = 1.0 if v >= 0 else -1.0
         nv = comb(ct["normal"], index, n)
         tv = comb(ct["tangent"], index, n)

@@ -88,6 +88,73 @@ def fmt(x):
     return repr(float(x))
 
 
+def labels_of(names):
+    """(node, component) of each dof name `<node>_<component>`."""
+    return [tuple(int(x) for x in n.split("_")) for n in names]
+
+
+def write_dmig(path, mats, names):
+    """Nastran DMIG bulk data, free field, form 6 (symmetric: the upper
+    triangle by index), real double precision (TIN=2), one card per entry;
+    every matrix in one file, chosen by name."""
+    lab = labels_of(names)
+    with open(path, "w") as f:
+        f.write("$ Written by make_brake.py: DMIG, free field, form 6, real double\n")
+        for name, mat in mats:
+            coo = sp.triu(sp.coo_matrix(mat)).tocoo()
+            f.write(f"DMIG,{name},0,6,2,0,,,{mat.shape[0]}\n")
+            entries = sorted(zip(coo.col, coo.row, coo.data))
+            for j, i, v in entries:
+                gj, cj = lab[j]
+                gi, ci = lab[i]
+                f.write(f"DMIG,{name},{gj},{cj},,{gi},{ci},{float(v)!r}\n")
+
+
+def write_abaqus(path, mat, names):
+    """Abaqus *MATRIX OUTPUT, FORMAT=MATRIX INPUT: `node, dof, node, dof,
+    value`, the lower triangle as Abaqus writes it."""
+    lab = labels_of(names)
+    coo = sp.tril(sp.coo_matrix(mat)).tocoo()
+    with open(path, "w") as f:
+        for i, j, v in sorted(zip(coo.row, coo.col, coo.data)):
+            (gi, ci), (gj, cj) = lab[i], lab[j]
+            f.write(f"{gi},{ci}, {gj},{cj}, {float(v):.16e}\n")
+
+
+ANSYS = {1: "UX", 2: "UY", 3: "UZ", 4: "ROTX", 5: "ROTY", 6: "ROTZ"}
+
+
+def write_hb_rsa(path, mat, names, title):
+    """Harwell-Boeing RSA (the lower triangle column by column, as ANSYS
+    HBMAT writes K and M), values (3E26.17), and ANSYS's mapping file
+    beside it (same name, .mapping)."""
+    csc = sp.tril(sp.csc_matrix(mat)).tocsc()
+    csc.sort_indices()
+    n = mat.shape[0]
+    ptr = [int(x) + 1 for x in csc.indptr]
+    ind = [int(x) + 1 for x in csc.indices]
+    val = [float(x) for x in csc.data]
+
+    def lines(items, per, width, fmtf):
+        return ["".join(fmtf(x).rjust(width) for x in items[k:k + per]) for k in range(0, len(items), per)]
+
+    pl = lines(ptr, 8, 10, str)
+    il = lines(ind, 8, 10, str)
+    vl = lines(val, 3, 26, lambda x: f"{x:.17E}")
+    with open(path, "w") as f:
+        f.write(f"{title:<72}{'KEY':<8}\n")
+        f.write(f"{len(pl) + len(il) + len(vl):14d}{len(pl):14d}{len(il):14d}{len(vl):14d}{0:14d}\n")
+        f.write(f"{'RSA':<14}{n:14d}{n:14d}{len(val):14d}{0:14d}\n")
+        f.write(f"{'(8I10)':<16}{'(8I10)':<16}{'(3E26.17)':<20}\n")
+        for l in pl + il + vl:
+            f.write(l + "\n")
+    mapping = os.path.splitext(path)[0] + ".mapping"
+    with open(mapping, "w") as f:
+        f.write("Matrix Eqn   Node   DOF\n")
+        for k, (node, comp) in enumerate(labels_of(names)):
+            f.write(f"{k + 1:10d} {node:10d}     {ANSYS[comp]}\n")
+
+
 def write(out, name, n_el, pads, args):
     """Write `<name>.toml` and its matrices for the given pads."""
     k, m = ring(n_el, args.radius, args.thickness, args.width, 210e9, 7850.0, args.hub_k)
@@ -123,6 +190,11 @@ def write(out, name, n_el, pads, args):
             symmetry="symmetric",
             precision=17,
         )
+    # The same matrices in the FE packages' formats.
+    write_dmig(os.path.join(folder, "brake.pch"), [("MAAX", mm), ("KAAX", kk), ("BAAX", c)], names)
+    for key, suffix, mat in (("M", "MASS1", mm), ("K", "STIF1", kk), ("C", "DMPV1", c)):
+        write_abaqus(os.path.join(folder, f"brake_{suffix}.mtx"), mat, names)
+        write_hb_rsa(os.path.join(folder, f"brake_{key}.matrix"), mat, names, f"{name} {key} from make_brake.py")
     half = args.thickness / 2.0
     lines = [
         f"# Written by make_brake.py --elements {n_el}: a ring disc of {n_el} beam elements",
@@ -134,6 +206,10 @@ def write(out, name, n_el, pads, args):
         "sample_rate = 200000.0",
         'initial = "equilibrium"',
         "dofs = [" + ", ".join(f'"{d}"' for d in names) + "]",
+        "",
+        "[params]                          # shared by the pads: --param mu=0.2:1.2 moves all",
+        f"mu = {fmt(args.mu)}",
+        f"Fb = {fmt(args.force)}",
         "",
         "[matrices]",
         'M = "M.mtx"',
@@ -154,7 +230,7 @@ def write(out, name, n_el, pads, args):
             "[[force]]",
             f'name = "brake_{pid}"',
             f"on = {{ {pid}_3 = 1.0 }}",
-            f"value = {fmt(-side * p['force_share'] * args.force)}",
+            f'value = "{fmt(-side * p["force_share"])}*Fb"',
             "",
             "[[contact]]",
             f'name = "{p["name"]}"',
@@ -165,11 +241,22 @@ def write(out, name, n_el, pads, args):
             f"tangent = {surface}",
             f"V = {fmt(args.speed)}",
             'friction = "coulomb"',
-            f"mu_s = {fmt(p['mu_ratio'] * args.mu * 1.2)}",
-            f"mu_k = {fmt(p['mu_ratio'] * args.mu)}",
+            f'mu_s = "{fmt(p["mu_ratio"] * 1.2)}*mu"',
+            f'mu_k = "{fmt(p["mu_ratio"])}*mu"',
         ]
+    text = "\n".join(lines) + "\n"
     with open(os.path.join(folder, "brake.toml"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+        f.write(text)
+    matrices = '[matrices]\nM = "M.mtx"\nK = "K.mtx"\nC = "C.mtx"\n'
+    variants = {
+        "dmig": '[matrices]\nM = { file = "brake.pch", name = "MAAX" }\n'
+        'K = { file = "brake.pch", name = "KAAX" }\nC = { file = "brake.pch", name = "BAAX" }\n',
+        "abaqus": '[matrices]\nM = "brake_MASS1.mtx"\nK = "brake_STIF1.mtx"\nC = "brake_DMPV1.mtx"\n',
+        "hb": '[matrices]\nM = "brake_M.matrix"\nK = "brake_K.matrix"\nC = "brake_C.matrix"\n',
+    }
+    for fmt_name, m in variants.items():
+        with open(os.path.join(folder, f"brake-{fmt_name}.toml"), "w") as f:
+            f.write(text.replace(matrices, m).replace(f'name = "{name}"', f'name = "{name}-{fmt_name}"'))
     return ndof
 
 
@@ -181,8 +268,8 @@ def main():
     ap.add_argument("--width", type=float, default=0.05)
     ap.add_argument("--hub-k", type=float, default=1.0e6)
     ap.add_argument("--caliper-k", type=float, default=4.0e7)
-    ap.add_argument("--piston-k", type=float, default=5.0e6)
-    ap.add_argument("--incline", type=float, default=0.5, help="abutment angle (rad)")
+    ap.add_argument("--piston-k", type=float, default=5.0e7)
+    ap.add_argument("--incline", type=float, default=1.0, help="abutment angle (rad)")
     ap.add_argument("--damping-a", type=float, default=2.0)
     ap.add_argument("--damping-b", type=float, default=1.0e-8)
     ap.add_argument("--mu", type=float, default=0.45)

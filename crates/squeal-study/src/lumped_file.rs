@@ -4,20 +4,29 @@
 //! (`spring 'disc_x': on: unknown dof 'x_q'`). Matrix Market files named in
 //! `[matrices]` are read relative to the scenario file's folder.
 
+use crate::matrix_file::MatrixInfo;
 use crate::scenario::InputError;
+use squeal_core::labelled::LabelledMatrix;
 use squeal_core::model::contact::Normal;
 use squeal_core::model::lumped::shared::Shared;
 use squeal_core::model::lumped::MAX_MODEL_DOFS;
-use squeal_core::model::lumped::{ContactSpec, ForceSpec, LumpedSpec, SpringSpec, Terms, Triplets};
+use squeal_core::model::lumped::{ContactSpec, ForceSpec, LumpedSpec, SpringSpec, Terms};
 use squeal_core::{FrictionLaw, Lumped};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Where a lumped model's matrices came from (kept for `scenario show`).
+/// Where a lumped model's matrices came from (kept for `scenario show`
+/// and `inspect`).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct MatrixFiles {
     /// `M`, `K`, `C` paths as written in the file.
     pub paths: Vec<(String, String)>,
+    /// What was read from each (format, size, nonzeros, symmetry), in the
+    /// order `M`, `K`, `C`.
+    pub info: Vec<MatrixInfo>,
+    /// The dofs without mass, condensed statically before any analysis
+    /// ([`squeal_core::model::lumped::condense`]).
+    pub condensed: Vec<String>,
 }
 
 /// The top-level keys a lumped scenario adds.
@@ -155,26 +164,41 @@ pub fn parse(
         shared: Shared::new(&spec.params).map_err(InputError)?,
         bound: Vec::new(),
     };
+    let mut read: Vec<(LabelledMatrix, MatrixInfo)> = Vec::new();
     if let Some(m) = table.get("matrices") {
         let toml::Value::Table(m) = m else {
             return err(format!(
-                "matrices = {m}: expected a table [matrices] with M, K, C file names"
+                "matrices = {m}: expected a table [matrices] with M, K, C files"
             ));
         };
         check_keys("matrices", m, &["M", "K", "C"])?;
         for (key, v) in m {
-            let toml::Value::String(p) = v else {
-                return err(format!(
-                    "matrices: {key} = {v}: expected a file name (Matrix Market, .mtx)"
-                ));
+            let (p, name, format) = match v {
+                toml::Value::String(p) => (p.clone(), None, None),
+                toml::Value::Table(t) => {
+                    let what = format!("matrices: {key}");
+                    check_keys(&what, t, &["file", "name", "format"])?;
+                    let text = |k: &str| match t.get(k) {
+                        None => Ok(None),
+                        Some(toml::Value::String(s)) => Ok(Some(s.clone())),
+                        Some(o) => err(format!("{what}: {k} = {o}: expected a string")),
+                    };
+                    let file = text("file")?
+                        .ok_or_else(|| InputError(format!("{what}: file: missing")))?;
+                    (file, text("name")?, text("format")?)
+                }
+                _ => {
+                    return err(format!(
+                        "matrices: {key} = {v}: expected a file name, or {{ file = \"…\", name = \"…\" }}"
+                    ))
+                }
             };
-            let path = base.map_or_else(|| PathBuf::from(p), |b| b.join(p));
-            let text = crate::input::read_regular_text(&path, crate::input::MAX_MATRIX_BYTES)
-                .map_err(|e| InputError(format!("matrices: {key} = '{p}': {e}")))?;
-            let t: Triplets = squeal_core::matrix_market::parse(&text)
-                .map_err(|e| InputError(format!("matrices: {key} = '{p}': {e}")))?;
+            let path = base.map_or_else(|| PathBuf::from(&p), |b| b.join(&p));
+            let (lm, info) =
+                crate::matrix_file::read(key, &path, &p, name.as_deref(), format.as_deref())?;
             // The model's size limit, from the header, before anything is
             // sized from it.
+            let t = &lm.triplets;
             if t.rows.max(t.cols) > MAX_MODEL_DOFS {
                 return err(format!(
                     "matrices: {key} = '{p}' is {}×{}: more than the {MAX_MODEL_DOFS} dofs a model may have",
@@ -182,23 +206,42 @@ pub fn parse(
                 ));
             }
             files.paths.push((key.clone(), p.clone()));
-            match key.as_str() {
-                "M" => spec.m = Some(t),
-                "K" => spec.k = Some(t),
-                _ => spec.c = Some(t),
-            }
+            read.push((lm, info));
         }
     }
-    spec.dofs = match table.get("dofs") {
-        Some(toml::Value::Array(a)) => a
-            .iter()
-            .map(|v| match v {
-                toml::Value::String(s) => Ok(s.clone()),
-                other => err(format!("dofs: {other}: expected dof names (strings)")),
-            })
-            .collect::<Result<_, _>>()?,
+    let listed: Option<Vec<String>> = match table.get("dofs") {
+        Some(toml::Value::Array(a)) => Some(
+            a.iter()
+                .map(|v| match v {
+                    toml::Value::String(s) => Ok(s.clone()),
+                    other => err(format!("dofs: {other}: expected dof names (strings)")),
+                })
+                .collect::<Result<_, _>>()?,
+        ),
         Some(other) => return err(format!("dofs = {other}: expected a list of names")),
-        None => {
+        None => None,
+    };
+    let labelled = read.iter().any(|(m, _)| m.labels.is_some());
+    let union = if labelled {
+        Some(crate::matrix_file::union_dofs(
+            &mut read,
+            listed.as_deref(),
+        )?)
+    } else {
+        None
+    };
+    for (lm, info) in read {
+        match info.key.as_str() {
+            "M" => spec.m = Some(lm.triplets),
+            "K" => spec.k = Some(lm.triplets),
+            _ => spec.c = Some(lm.triplets),
+        }
+        files.info.push(info);
+    }
+    spec.dofs = match (union, listed) {
+        (Some(u), _) => u,
+        (None, Some(listed)) => listed,
+        (None, None) => {
             // Numbered after the matrices: q1 … qn.
             let (nkey, n) = [("M", &spec.m), ("K", &spec.k), ("C", &spec.c)]
                 .iter()
@@ -347,6 +390,8 @@ pub fn parse(
         });
     }
     spec.expressions = ex.bound;
+    files.condensed = squeal_core::model::lumped::condense::condense_massless(&mut spec)
+        .map_err(|e| InputError(e.0))?;
     let model = Lumped::build(&spec).map_err(|e| InputError(e.0))?;
     Ok((model, files))
 }
@@ -384,10 +429,22 @@ pub fn to_toml(l: &Lumped, files: &MatrixFiles) -> String {
     if !files.paths.is_empty() {
         let _ = writeln!(
             t,
-            "\n[matrices]                        # Matrix Market files, relative to this file"
+            "\n[matrices]                        # matrix files (Matrix Market, DMIG, Abaqus, Harwell–Boeing), relative to this file"
         );
         for (k, p) in &files.paths {
-            let _ = writeln!(t, "{k} = {p:?}");
+            // A matrix chosen by name in a file of several keeps its name.
+            match files
+                .info
+                .iter()
+                .find(|i| &i.key == k && !i.name.is_empty())
+            {
+                Some(i) => {
+                    let _ = writeln!(t, "{k} = {{ file = {p:?}, name = {:?} }}", i.name);
+                }
+                None => {
+                    let _ = writeln!(t, "{k} = {p:?}");
+                }
+            }
         }
     }
     let masses: Vec<(String, f64)> = l

@@ -40,6 +40,8 @@ enum Command {
     Simulate(commands::simulate::SimulateArgs),
     /// Eigen-analysis of steady sliding: every mode's growth rate, frequency, damping.
     Stability(commands::stability::StabilityArgs),
+    /// What a scenario's files hold: matrices (format, size, symmetry), dofs, natural frequencies, contacts.
+    Inspect(commands::inspect::InspectArgs),
     /// Stability map over a grid of two parameters (linear, or --transient by simulation).
     Map(commands::map::MapArgs),
     /// Gather the shards of a map (`map … --shard K/N`) into the map the unsharded run writes.
@@ -136,6 +138,7 @@ fn dispatch(command: Command) -> Result<(), RunError> {
         Command::Plot(a) => commands::plot::run(a),
         Command::Reproduce(a) => commands::reproduce::run(a),
         Command::Stability(a) => commands::stability::run(a),
+        Command::Inspect(a) => commands::inspect::run(a),
         Command::Map(a) => commands::map::run(a),
         Command::Merge(a) => commands::merge::run(a),
         Command::Slurm { what } => commands::slurm::run(what),

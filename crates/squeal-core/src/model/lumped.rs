@@ -2345,6 +2345,7 @@ pub const MAX_MODEL_DOFS: usize = 1_000_000;
 /// [`padding`]). Stability analysis works for any size.
 pub const MAX_SIM_DOFS: usize = 64;
 
+pub mod condense;
 pub mod lanes;
 pub mod padding;
 pub mod shared;
