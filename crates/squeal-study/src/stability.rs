@@ -21,6 +21,101 @@ pub fn analyse(model: &AnyModel) -> Result<Analysis, StabilityError> {
     model.analyse()
 }
 
+/// The real modes each growing mode of a lumped model is made of
+/// (issue 26 §5): per growing eigenvalue (`+ω` of its pair), its index in
+/// `an.eigen`, its `Composition` over the undamped modes of `M` and the
+/// symmetric stiffness at steady sliding (every mode up to
+/// `modal.dense_max_dofs` dofs, the projection basis above), and the
+/// contact dofs where it moves most (amplitude relative to its largest).
+pub fn coupled_modes(model: &AnyModel, an: &Analysis) -> Vec<CoupledMode> {
+    use squeal_core::model::contact::Normal;
+    use squeal_core::stability::projected::{undamped_basis, Basis};
+    let AnyModel::Lumped(l) = model else {
+        return Vec::new();
+    };
+    let n = l.dof_count();
+    let growing: Vec<usize> = (0..an.eigen.len())
+        .filter(|&i| an.eigen[i].growing && an.eigen[i].im >= 0.0)
+        .collect();
+    if growing.is_empty() {
+        return Vec::new();
+    }
+    let sys = l.second_order_dyn(&an.equilibrium);
+    let basis = if l.modal.projects(n) {
+        l.modal.basis()
+    } else {
+        Basis::Modes(n)
+    };
+    let Ok(basis) = undamped_basis(&sys, basis) else {
+        return Vec::new();
+    };
+    let mut contact_dofs: Vec<usize> = Vec::new();
+    for c in &l.contacts {
+        if let Normal::Elastic { normal, .. } = &c.normal {
+            contact_dofs.extend(&normal.idx);
+        }
+        contact_dofs.extend(&c.tangent.idx);
+    }
+    contact_dofs.sort_unstable();
+    contact_dofs.dedup();
+    growing
+        .into_iter()
+        .map(|i| {
+            let e = &an.eigen[i];
+            let q = &e.vector[..n];
+            let top = q.iter().fold(0.0f64, |m, v| m.max(v.norm()));
+            let mut at: Vec<(String, f64)> = contact_dofs
+                .iter()
+                .map(|&d| {
+                    (
+                        l.dofs()[d].clone(),
+                        if top > 0.0 { q[d].norm() / top } else { 0.0 },
+                    )
+                })
+                .collect();
+            at.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+            at.truncate(3);
+            CoupledMode {
+                eigenvalue: i,
+                composition: squeal_core::stability::coupling::composition(
+                    &sys.m, &basis, q, 0.01, 5,
+                ),
+                contact_dofs: at,
+            }
+        })
+        .collect()
+}
+
+/// A growing mode and the real modes it is made of ([`coupled_modes`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CoupledMode {
+    /// Index in [`Analysis::eigen`].
+    pub eigenvalue: usize,
+    /// Its real modes and their shares (those ≥ 1 %, at most 5).
+    pub composition: squeal_core::stability::coupling::Composition,
+    /// The contact dofs where it moves most, amplitude relative to its
+    /// largest (at most 3).
+    pub contact_dofs: Vec<(String, f64)>,
+}
+
+/// The JSON of [`coupled_modes`].
+pub fn coupled_json(an: &Analysis, c: &[CoupledMode]) -> Value {
+    json!(c
+        .iter()
+        .map(|m| {
+            let e = &an.eigen[m.eigenvalue];
+            json!({
+                "eigenvalue": m.eigenvalue + 1,
+                "freq_hz": e.freq_hz,
+                "growth_rate": e.re,
+                "real_modes": m.composition.shares,
+                "captured": m.composition.captured,
+                "contact_dofs": m.contact_dofs.iter().map(|(d, a)| json!({ "dof": d, "amplitude": a })).collect::<Vec<_>>(),
+            })
+        })
+        .collect::<Vec<_>>())
+}
+
 /// The JSON document of an analysis.
 pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
     let names = model.state_names();
@@ -57,6 +152,7 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
         "equilibrium": eq,
         "shape_normalisation": SHAPE_NORMALISATION,
         "modal": modal_json(an),
+        "coupled_modes": coupled_json(an, &coupled_modes(model, an)),
     })
 }
 

@@ -3,7 +3,9 @@
 //! Each file of this folder is a module; a new test file is declared here.
 
 mod cli;
+mod condense_cli;
 mod cycle_cli;
+mod fe_files_cli;
 mod lumped_cli;
 mod params_cli;
 mod reliability;

@@ -40,6 +40,7 @@
 //! The eigen-solver is [`eigen`] (balancing + Hessenberg + Francis QR, with
 //! the reasons it is hand-written).
 
+pub mod coupling;
 pub mod eigen;
 pub mod lumped;
 pub mod modal;

@@ -148,6 +148,40 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         ls.dominant_name,
         ls.re
     );
+    for c in squeal_study::stability::coupled_modes(&sc.model, &an) {
+        let e = &an.eigen[c.eigenvalue];
+        let parts: Vec<String> = c
+            .composition
+            .shares
+            .iter()
+            .map(|s| {
+                format!(
+                    "{:.0} % real mode {} ({:.2} Hz)",
+                    100.0 * s.share,
+                    s.mode,
+                    s.freq_hz
+                )
+            })
+            .collect();
+        let at: Vec<String> = c
+            .contact_dofs
+            .iter()
+            .map(|(d, a)| format!("{d} ({a:.2})"))
+            .collect();
+        crate::outln!(
+            "growing mode #{} ({:.2} Hz, σ = {:+.4e} 1/s) is made of {}{}; at the contacts it moves most {}",
+            c.eigenvalue + 1,
+            e.freq_hz,
+            e.re,
+            parts.join(", "),
+            if c.composition.captured < 0.99 {
+                format!(" (the basis holds {:.0} % of it)", 100.0 * c.composition.captured)
+            } else {
+                String::new()
+            },
+            at.join(", ")
+        );
+    }
     if large {
         crate::outln!(
             "(levers are searched only for models of up to {} dofs)",
