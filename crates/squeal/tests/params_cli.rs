@@ -392,3 +392,34 @@ fn bad_parameters_and_expressions_are_refused_naming_the_key() {
         "{e}"
     );
 }
+
+/// The shipped symmetric two-pad brake shares its pads' friction law:
+/// `--set f1=…` moves both pads, as setting each pad does.
+#[test]
+fn the_shipped_two_pad_brake_shares_its_friction_law() {
+    let d = tempfile::tempdir().unwrap();
+    let a = json(&squeal(
+        d.path(),
+        &["stability", "two-pad-brake", "--json", "--set", "f1=0.03"],
+    ));
+    let b = json(&squeal(
+        d.path(),
+        &[
+            "stability",
+            "two-pad-brake",
+            "--json",
+            "--set",
+            "pad1.f1=0.03",
+            "--set",
+            "pad2.f1=0.03",
+        ],
+    ));
+    assert_eq!(eigenvalues(&a), eigenvalues(&b));
+    let c = json(&squeal(d.path(), &["stability", "two-pad-brake", "--json"]));
+    assert_ne!(eigenvalues(&a), eigenvalues(&c));
+    let shown = ok(&squeal(d.path(), &["scenario", "show", "two-pad-brake"]));
+    assert!(
+        shown.contains("f1 = \"f1\"  # = 0.06666666666666667"),
+        "{shown}"
+    );
+}
