@@ -165,14 +165,30 @@ pub fn parse(
         bound: Vec::new(),
     };
     let mut read: Vec<(LabelledMatrix, MatrixInfo)> = Vec::new();
+    let mut scales: Vec<(String, f64)> = Vec::new();
     if let Some(m) = table.get("matrices") {
         let toml::Value::Table(m) = m else {
             return err(format!(
                 "matrices = {m}: expected a table [matrices] with M, K, C files"
             ));
         };
-        check_keys("matrices", m, &["M", "K", "C"])?;
+        check_keys(
+            "matrices",
+            m,
+            &["M", "K", "C", "M_scale", "K_scale", "C_scale"],
+        )?;
         for (key, v) in m {
+            if key.ends_with("_scale") {
+                // Applied to the built model (a number or an expression).
+                if !m.contains_key(&key[..1]) {
+                    return err(format!(
+                        "matrices: {key}: there is no matrix {} to scale",
+                        &key[..1]
+                    ));
+                }
+                scales.push((key.clone(), ex.value("matrices", "matrices", key, v)?));
+                continue;
+            }
             let (p, name, format) = match v {
                 toml::Value::String(p) => (p.clone(), None, None),
                 toml::Value::Table(t) => {
@@ -392,7 +408,15 @@ pub fn parse(
     spec.expressions = ex.bound;
     files.condensed = squeal_core::model::lumped::condense::condense_massless(&mut spec)
         .map_err(|e| InputError(e.0))?;
-    let model = Lumped::build(&spec).map_err(|e| InputError(e.0))?;
+    let mut model = Lumped::build(&spec).map_err(|e| InputError(e.0))?;
+    for (k, v) in scales {
+        let key = format!("matrices.{k}");
+        if model.shared().binding(&key).is_none() {
+            model
+                .set(&key, v)
+                .map_err(|e| InputError(format!("matrices: {e}")))?;
+        }
+    }
     Ok((model, files))
 }
 
@@ -444,6 +468,15 @@ pub fn to_toml(l: &Lumped, files: &MatrixFiles) -> String {
                 None => {
                     let _ = writeln!(t, "{k} = {p:?}");
                 }
+            }
+        }
+        for s in squeal_core::model::lumped::MATRIX_SCALE_KEYS {
+            let key = format!("matrices.{s}");
+            if let Some(v) = l
+                .get(&key)
+                .filter(|v| *v != 1.0 || l.shared().binding(&key).is_some())
+            {
+                let _ = writeln!(t, "{s} = {}", val(key, v));
             }
         }
     }

@@ -113,3 +113,53 @@ fn an_element_on_a_massless_dof_is_refused_by_name() {
         "{e}"
     );
 }
+
+fn frequencies(dir: &Path, args: &[&str]) -> Vec<f64> {
+    let mut all = vec!["stability", "chain.toml", "--json"];
+    all.extend(args);
+    let v: serde_json::Value = serde_json::from_str(&ok(&squeal(dir, &all))).unwrap();
+    let mut w: Vec<f64> = v["eigenvalues"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["im"].as_f64().unwrap())
+        .filter(|w| *w > 0.0)
+        .collect();
+    w.sort_by(f64::total_cmp);
+    w
+}
+
+/// `matrices.K_scale` and `matrices.M_scale` (issue 26 §4's per-file
+/// levers): an undamped structure's frequencies scale by √(K_scale/M_scale)
+/// exactly; in the file or by --set alike; a negative scale is refused.
+#[test]
+fn matrix_scale_keys_scale_the_frequencies_exactly() {
+    let d = tempfile::tempdir().unwrap();
+    write_chain(d.path(), "1_1");
+    let base = frequencies(d.path(), &[]);
+    let k2 = frequencies(d.path(), &["--set", "matrices.K_scale=2"]);
+    let m4 = frequencies(d.path(), &["--set", "matrices.M_scale=4"]);
+    for i in 0..2 {
+        assert!((k2[i] - base[i] * 2f64.sqrt()).abs() <= 1e-12 * k2[i]);
+        assert!((m4[i] - base[i] / 2.0).abs() <= 1e-12 * m4[i]);
+    }
+    let text = std::fs::read_to_string(d.path().join("chain.toml")).unwrap();
+    std::fs::write(
+        d.path().join("chain.toml"),
+        text.replace("[matrices]\n", "[matrices]\nK_scale = 2.0\n"),
+    )
+    .unwrap();
+    assert_eq!(frequencies(d.path(), &[]), k2);
+    let out = squeal(
+        d.path(),
+        &["stability", "chain.toml", "--set", "matrices.K_scale=-1"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("matrices.K_scale = -1"), "{e}");
+    let out = squeal(
+        d.path(),
+        &["stability", "chain.toml", "--set", "matrices.C_scale=2"],
+    );
+    assert_eq!(out.status.code(), Some(2), "no C matrix: no C_scale");
+}

@@ -114,6 +114,16 @@ impl Sparse {
             out[r] += a * s;
         }
     }
+    /// Every entry times `f` (`f = 1`: an exact copy).
+    pub fn scaled(&self, f: f64) -> Sparse {
+        let mut s = self.clone();
+        if f != 1.0 {
+            for v in &mut s.val {
+                *v *= f;
+            }
+        }
+        s
+    }
     /// Entry `(r, c)`.
     pub fn get(&self, r: usize, c: usize) -> f64 {
         (self.row_ptr[r]..self.row_ptr[r + 1])
@@ -270,6 +280,10 @@ pub struct Lumped {
     m_matrix: Option<Sparse>,
     k_matrix: Option<Sparse>,
     c_matrix: Option<Sparse>,
+    /// `M`, `K`, `C` as read, and the scale factor each is used with
+    /// (keys `matrices.M_scale`, `matrices.K_scale`, `matrices.C_scale`).
+    matrix_base: [Option<Sparse>; 3],
+    matrix_scale: [f64; 3],
     /// Springs. Change their parameters through [`Lumped::set`]: the
     /// right-hand side of a small model uses operators derived from them.
     pub springs: Vec<Spring>,
@@ -297,6 +311,9 @@ pub struct Lumped {
     /// [`DENSE_FIELD_DOFS`] dofs); rebuilt whenever a parameter changes.
     dense: Option<DenseField>,
 }
+
+/// The keys scaling the matrices read from files: `matrices.<key>`.
+pub const MATRIX_SCALE_KEYS: [&str; 3] = ["M_scale", "K_scale", "C_scale"];
 
 /// Up to this many dofs the simulated right-hand side runs on operators
 /// folded once per parameter change (every spring, `K` and `C` in one
@@ -721,6 +738,8 @@ impl Lumped {
                 .collect(),
             dofs: spec.dofs.clone(),
             masses,
+            matrix_base: [m_matrix.clone(), k_matrix.clone(), c_matrix.clone()],
+            matrix_scale: [1.0; 3],
             m_matrix,
             k_matrix,
             c_matrix,
@@ -1662,6 +1681,11 @@ impl Lumped {
             .params()
             .map(|(n, v)| (n.to_string(), v))
             .collect();
+        for (i, key) in MATRIX_SCALE_KEYS.iter().enumerate() {
+            if self.matrix_base[i].is_some() {
+                out.push((format!("matrices.{key}"), self.matrix_scale[i]));
+            }
+        }
         for (d, m) in self.dofs.iter().zip(&self.masses) {
             if *m > 0.0 {
                 out.push((format!("mass.{d}"), *m));
@@ -1823,6 +1847,34 @@ impl Lumped {
                 }
                 _ => return Err(unknown()),
             }
+        } else if el == "matrices" {
+            let i = MATRIX_SCALE_KEYS
+                .iter()
+                .position(|x| *x == k)
+                .filter(|&i| self.matrix_base[i].is_some())
+                .ok_or_else(unknown)?;
+            let ok = if i == 0 {
+                value.is_finite() && value > 0.0
+            } else {
+                value.is_finite() && value >= 0.0
+            };
+            if !ok {
+                return Err(invalid(if i == 0 {
+                    "a mass matrix's scale must be a finite number > 0"
+                } else {
+                    "must be a finite number ≥ 0"
+                }));
+            }
+            self.matrix_scale[i] = value;
+            let m = self.matrix_base[i].as_ref().map(|b| b.scaled(value));
+            match i {
+                0 => {
+                    self.m_matrix = m;
+                    refresh = true;
+                }
+                1 => self.k_matrix = m,
+                _ => self.c_matrix = m,
+            }
         } else if el == "modal" {
             let count = |v: f64| {
                 if v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v <= 1e9 {
@@ -1881,6 +1933,12 @@ impl Lumped {
         if el == "mass" {
             return Some(("kg", format!("mass of dof {k}")));
         }
+        if el == "matrices" && self.get(key).is_some() {
+            return Some((
+                "",
+                format!("scale factor of the matrix {} read from its file", &k[..1]),
+            ));
+        }
         if el == "modal" && self.modal_get(key).is_some() {
             return Some(match k {
                 "dense_max_dofs" => ("", "largest model (dofs) solved by the dense eigen-analysis; larger ones by projection onto undamped modes".to_string()),
@@ -1931,8 +1989,11 @@ impl Lumped {
                 .map_or(ParamKind::Any, |b| self.kind_of(&b.key));
         }
         let (el, k) = key.split_once('.').unwrap_or(("", key));
-        if el == "mass" {
+        if el == "mass" || key == "matrices.M_scale" {
             return ParamKind::Positive;
+        }
+        if el == "matrices" {
+            return ParamKind::NonNegative;
         }
         if el == "modal" {
             return if k == "cutoff_hz" {
