@@ -3,6 +3,7 @@
 //! Each file of this folder is a module; a new test file is declared here.
 
 mod cli;
+mod cli_common;
 mod condense_cli;
 mod cycle_cli;
 mod fe_files_cli;

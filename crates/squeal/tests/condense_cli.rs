@@ -3,25 +3,8 @@
 //! where an element acts on them. Checked against the closed form of a
 //! chain with a massless middle node (two springs in series).
 
+use crate::cli_common::{ok, squeal};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn squeal(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_squeal"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("squeal runs")
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
 
 /// Two masses `m` on ground springs `k0`, joined through a massless node
 /// `2_1` by springs `k1` and `k2` (series: `ks = k1 k2 / (k1 + k2)`), in

@@ -7,51 +7,13 @@
 //! `squeal inspect` says what was read, and bad files are refused in one
 //! line naming the file, the line and what is wrong.
 
+use crate::cli_common::{eigenvalues, json, ok, refused, squeal};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn squeal(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_squeal"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("squeal runs")
-}
 
 fn example(model: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples/fe-brake")
         .join(model)
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn json(out: &Output) -> serde_json::Value {
-    serde_json::from_str(&ok(out)).unwrap()
-}
-
-fn refused(out: &Output) -> String {
-    assert_eq!(out.status.code(), Some(2), "{out:?}");
-    assert!(out.stdout.is_empty());
-    let e = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(e.trim().lines().count(), 1, "one line: {e}");
-    e
-}
-
-fn eigenvalues(v: &serde_json::Value) -> Vec<(f64, f64)> {
-    v["eigenvalues"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|e| (e["re"].as_f64().unwrap(), e["im"].as_f64().unwrap()))
-        .collect()
 }
 
 #[test]

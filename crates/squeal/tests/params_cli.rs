@@ -4,36 +4,8 @@
 //! show`, summary.json, `--set <contact>.friction=<law>`, and bad input.
 //! Each result is checked against the same model written with numbers.
 
+use crate::cli_common::{eigenvalues, json, ok, refused, squeal};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn squeal(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_squeal"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("squeal runs")
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn refused(out: &Output) -> String {
-    assert_eq!(out.status.code(), Some(2), "{out:?}");
-    let e = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(e.trim().lines().count(), 1, "one line: {e}");
-    e
-}
-
-fn json(out: &Output) -> serde_json::Value {
-    serde_json::from_str(&ok(out)).unwrap()
-}
 
 /// A disc between two pads; `friction` holds the two contacts' law keys
 /// (`{p}` is replaced by the pad's number), `head` goes before the
@@ -108,15 +80,6 @@ V = 1.0
 fn write(dir: &Path, name: &str, text: &str) -> String {
     std::fs::write(dir.join(name), text).unwrap();
     name.into()
-}
-
-fn eigenvalues(v: &serde_json::Value) -> Vec<(f64, f64)> {
-    v["eigenvalues"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|e| (e["re"].as_f64().unwrap(), e["im"].as_f64().unwrap()))
-        .collect()
 }
 
 const SHARED_HEAD: &str = "\n[params]\nmu = 0.3\nFb = 1000.0\n";
