@@ -15,6 +15,9 @@ the steady state's contact forces and the eigenvalues of
 
     python3 cea.py two-pad/brake.toml --set mu=0.6 > eig.json
 
+--repeat N does the linear algebra (steady solve, M^-1, state matrix,
+eigenvalues) N times, for timing against the N analyses of squeal's levers.
+
 Element values may be expressions of [params] (evaluated here with Python's
 arithmetic); --set sets a parameter (no dot) or an element key.
 """
@@ -39,9 +42,13 @@ def comb(terms, index, n):
 def main():
     path = sys.argv[1]
     sets = {}
+    repeat = 1
     args = sys.argv[2:]
     while args:
-        if args[0] == "--set":
+        if args[0] == "--repeat":
+            repeat = int(args[1])
+            args = args[2:]
+        elif args[0] == "--set":
             k, v = args[1].split("=")
             sets[k] = float(v)
             args = args[2:]
@@ -92,10 +99,11 @@ def main():
         ks += kc * np.outer(nv, nv) + s * mu_k * kc * np.outer(tv, nv)
         cs += cc * np.outer(nv, nv) + s * mu_k * cc * np.outer(tv, nv)
         contacts.append((name, kc, nv))
-    q = np.linalg.solve(ks, b)
-    minv = np.linalg.inv(m)
-    a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv @ ks, -minv @ cs]])
-    lam = scipy.linalg.eigvals(a)
+    for _ in range(repeat):
+        q = np.linalg.solve(ks, b)
+        minv = np.linalg.inv(m)
+        a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv @ ks, -minv @ cs]])
+        lam = scipy.linalg.eigvals(a)
     order = np.lexsort((lam.imag, -lam.real))
     lam = lam[order]
     out = {

@@ -241,13 +241,13 @@ fn stability<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let sc = resolve(kind, text, &sets)?;
     // Without levers the analysis takes microseconds: no worker thread.
-    let work = |_: &Cancel| {
+    let work = |cancel: &Cancel| {
         let an = squeal_study::stability::analyse(&sc.model)
             .map_err(|e| squeal_study::feasible::stability_failure(&sc.model, e))?;
         let lev = if levers {
-            squeal_study::stability::levers_if_searched(&sc.model)
+            squeal_study::levers::search(&sc.model, &squeal_study::NoProgress, cancel)?
         } else {
-            Vec::new()
+            squeal_study::levers::Levers::none()
         };
         Ok((an, lev))
     };

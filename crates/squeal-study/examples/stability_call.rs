@@ -16,7 +16,7 @@ fn main() {
         for _ in 0..calls {
             let sc = resolve(Source::Spec("disc-pad"), &[]).expect("built-in");
             let an = analyse(&sc.model).expect("steady sliding");
-            let doc = document(&sc, &an, &[]);
+            let doc = document(&sc, &an, &squeal_study::levers::Levers::none());
             checksum += doc["max_growth_rate"].as_f64().unwrap_or(0.0);
         }
         let per = start.elapsed().as_secs_f64() / calls as f64;

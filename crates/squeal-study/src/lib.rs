@@ -16,6 +16,7 @@ pub mod error;
 pub mod feasible;
 pub mod input;
 pub mod inspect;
+pub mod levers;
 pub mod lumped_file;
 pub mod map;
 pub mod matrix_file;

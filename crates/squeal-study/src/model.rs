@@ -216,6 +216,44 @@ impl AnyModel {
                 lumped _l => unreachable!("handled above")),
         }
     }
+    /// Every eigenvalue of steady sliding, as [`max_growth_rate`](Self::max_growth_rate)
+    /// finds them (the fixed-size path where it applies, else dense or
+    /// projected as `modal` says).
+    pub fn eigenvalues(&self) -> Result<Vec<nalgebra::Complex<f64>>, StabilityError> {
+        if let AnyModel::Lumped(l) = self {
+            if l.modal.projects(l.dof_count()) {
+                return stability::lumped::eigenvalues(l);
+            }
+        }
+        crate::with_system!(self, m => stability::eigenvalues(m).map(|e| e.to_vec()),
+        else => match self {
+            AnyModel::Lumped(l) => stability::lumped::eigenvalues(l),
+            _ => unreachable!("only lumped models have no fixed size"),
+        })
+    }
+    /// The steady-sliding state and the full state matrix there, for a
+    /// model analysed densely; `None` for a lumped model analysed by
+    /// projection (above `modal.dense_max_dofs` dofs).
+    #[allow(clippy::type_complexity)]
+    pub fn state_matrix(
+        &self,
+    ) -> Option<Result<(Vec<f64>, nalgebra::DMatrix<f64>), StabilityError>> {
+        if let AnyModel::Lumped(l) = self {
+            if l.modal.projects(l.dof_count()) {
+                return None;
+            }
+        }
+        Some(
+            crate::with_system!(self, m => stability::state_matrix(m).map(|(z, a)| {
+                let n = z.len();
+                (z.to_vec(), nalgebra::DMatrix::from_fn(n, n, |i, j| a[i][j]))
+            }),
+            else => match self {
+                AnyModel::Lumped(l) => stability::lumped::state_matrix(l),
+                _ => unreachable!("only lumped models have no fixed size"),
+            }),
+        )
+    }
     /// Largest growth rate of steady sliding and its frequency (the fast path of maps).
     pub fn max_growth_rate(&self) -> Result<(f64, f64), StabilityError> {
         if let AnyModel::Lumped(l) = self {

@@ -3,9 +3,10 @@
 //! the verdict (MODEL.md §5), its JSON document, and the levers — the
 //! one-parameter changes that flip the verdict.
 
+pub use crate::levers::{Lever, Levers};
 use crate::model::AnyModel;
 use serde_json::{json, Value};
-use squeal_core::stability::{self, Analysis, CriticalOptions, StabilityError};
+use squeal_core::stability::{Analysis, StabilityError};
 
 /// How mode shapes are normalised (stated in the JSON and the README).
 pub const SHAPE_NORMALISATION: &str = "position part of the eigenvector divided by its largest component: that dof has amplitude 1 and phase 0, every amplitude is in [0, 1], phases in degrees in (-180, 180]";
@@ -156,32 +157,27 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
     })
 }
 
-/// Whether [`levers`] are searched for this model: they need hundreds of
-/// analyses, so only models of the fixed-size path (every built-in, lumped
-/// models up to `MAX_EXACT_DOFS` dofs) get them.
-pub fn searches_levers(model: &AnyModel) -> bool {
-    !matches!(model, AnyModel::Lumped(l)
-        if l.dof_count() > squeal_core::model::lumped::MAX_EXACT_DOFS)
+/// Whether levers are searched for this model: every model since issue 26
+/// (kept for callers that asked; see [`crate::levers`]).
+pub fn searches_levers(_model: &AnyModel) -> bool {
+    true
 }
 
-/// The levers of `model` when [`searches_levers`] says so, none otherwise.
-pub fn levers_if_searched(model: &AnyModel) -> Vec<Lever> {
-    if searches_levers(model) {
-        levers(model)
-    } else {
-        Vec::new()
-    }
+/// Every lever of `model` ([`crate::levers::search`]), without progress
+/// display or cancellation.
+pub fn levers_if_searched(model: &AnyModel) -> Result<Levers, crate::StudyError> {
+    crate::levers::search(model, &crate::NoProgress, &crate::Cancel::new())
 }
 
 /// The whole document of `squeal stability --json` (and of Python's
-/// `Stability.to_dict()`): [`analysis_json`] plus the scenario and the levers.
-pub fn document(sc: &crate::Scenario, an: &Analysis, levers: &[Lever]) -> Value {
+/// `Stability.to_dict()`): [`analysis_json`] plus the scenario and what
+/// [`Levers::to_json`] holds (`levers`, `sensitivities`, `mode_moves`, …).
+pub fn document(sc: &crate::Scenario, an: &Analysis, levers: &Levers) -> Value {
     let mut doc = analysis_json(&sc.model, an);
     doc["scenario"] = sc.to_json();
-    doc["levers"] = json!(levers
-        .iter()
-        .map(|l| json!({ "param": l.param, "from": l.from, "to": l.to, "freq_hz": l.freq_hz }))
-        .collect::<Vec<_>>());
+    if let (Value::Object(d), Value::Object(l)) = (&mut doc, levers.to_json()) {
+        d.extend(l);
+    }
     doc
 }
 
@@ -218,100 +214,5 @@ pub fn verdict_word(an: &Analysis) -> &'static str {
         "neutral"
     } else {
         "unstable"
-    }
-}
-
-/// One parameter change that alone flips the verdict (all else as is).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Lever {
-    /// Parameter name.
-    pub param: String,
-    /// Its unit.
-    pub unit: &'static str,
-    /// Its current value.
-    pub from: f64,
-    /// The value where the verdict flips.
-    pub to: f64,
-    /// Frequency (Hz) of the mode that crosses there.
-    pub freq_hz: f64,
-}
-
-/// "What would stop it" (or, for a quiet brake, what would start it): for
-/// every parameter, the nearest value above and below the current one where
-/// the stability of steady sliding changes, searched over ×1000 either way
-/// (±1e5 for a signed parameter) by [`stability::critical`].
-pub fn levers(model: &AnyModel) -> Vec<Lever> {
-    use squeal_core::params::ParamKind;
-    let mut out = Vec::new();
-    for (name, unit, _, kind) in model.keys() {
-        if name == "t_ramp" || name.ends_with(".ramp") {
-            continue; // a start-up setting, no part of steady sliding
-        }
-        let Some(cur) = model.get(&name) else {
-            continue;
-        };
-        let (lo, hi) = match kind {
-            ParamKind::Positive => (cur / 1000.0, cur * 1000.0),
-            ParamKind::NonNegative => (0.0, if cur > 0.0 { cur * 1000.0 } else { 1000.0 }),
-            ParamKind::Any => (
-                cur - 1e5 * cur.abs().max(1.0),
-                cur + 1e5 * cur.abs().max(1.0),
-            ),
-        };
-        for (a, b) in [(cur, hi), (cur, lo)] {
-            if (b - a).abs() <= 1e-12 * a.abs().max(1e-300) {
-                continue;
-            }
-            // Search outwards from the current value: s ∈ [0, 1] maps to a + s (b − a).
-            let f = |s: f64| crate::critical::growth_at(model, &name, a + s * (b - a));
-            let opts = CriticalOptions {
-                grid: 48,
-                ..CriticalOptions::default()
-            };
-            if let Ok(Some(c)) = stability::critical(f, 0.0, 1.0, &opts) {
-                let rough = a + c.value * (b - a);
-                // The scan's root is exact in s, i.e. to 1e-10·|b − a| in the
-                // parameter; refine it on the parameter itself, with the same
-                // Brent iteration and tolerance as `critical`, so a lever and
-                // `squeal critical` give the same boundary.
-                let (to, freq_hz) = refine(model, &name, rough, (b - a).abs(), (a, b))
-                    .unwrap_or((rough, c.freq_hz));
-                out.push(Lever {
-                    param: name.clone(),
-                    unit,
-                    from: cur,
-                    to,
-                    freq_hz,
-                });
-            }
-        }
-    }
-    out
-}
-
-/// The crossing near `rough` located on the parameter itself: a bracket of
-/// ±1e-9·`span` around it (inside the searched segment `seg`), then
-/// [`stability::critical`] with its default 1e-10 relative tolerance.
-fn refine(
-    model: &AnyModel,
-    name: &str,
-    rough: f64,
-    span: f64,
-    seg: (f64, f64),
-) -> Option<(f64, f64)> {
-    let (lo_seg, hi_seg) = (seg.0.min(seg.1), seg.0.max(seg.1));
-    let d = 1e-9 * span + 4.0 * f64::EPSILON * rough.abs();
-    let (lo, hi) = ((rough - d).max(lo_seg), (rough + d).min(hi_seg));
-    if lo >= hi {
-        return None;
-    }
-    let opts = CriticalOptions {
-        grid: 2,
-        ..CriticalOptions::default()
-    };
-    let f = |p: f64| crate::critical::growth_at(model, name, p);
-    match stability::critical(f, lo, hi, &opts) {
-        Ok(Some(c)) => Some((c.value, c.freq_hz)),
-        _ => None,
     }
 }

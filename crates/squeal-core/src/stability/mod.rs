@@ -45,6 +45,7 @@ pub mod eigen;
 pub mod lumped;
 pub mod modal;
 pub mod projected;
+pub mod sensitivity;
 pub mod sweep;
 pub mod track;
 
@@ -330,9 +331,7 @@ fn analyse_impl<M: System<N> + ?Sized, const N: usize>(
 pub fn max_growth_rate<M: System<N> + ?Sized, const N: usize>(
     model: &M,
 ) -> Result<(f64, f64), StabilityError> {
-    let (_, a) = state_matrix(model)?;
-    let ev = eigen::eigenvalues(&a).ok_or(StabilityError::NoConvergence)?;
-    check_finite(&ev)?;
+    let ev = eigenvalues(model)?;
     let mut best = Complex::new(f64::NEG_INFINITY, 0.0);
     for e in ev {
         if e.re > best.re || (e.re == best.re && e.im > best.im) {
@@ -340,6 +339,18 @@ pub fn max_growth_rate<M: System<N> + ?Sized, const N: usize>(
         }
     }
     Ok((best.re, best.im.abs() / (2.0 * std::f64::consts::PI)))
+}
+
+/// Every eigenvalue of the state matrix at steady sliding (the order of
+/// [`eigen::hqr`]), on stack arrays: the eigenvalues [`max_growth_rate`]
+/// picks from.
+pub fn eigenvalues<M: System<N> + ?Sized, const N: usize>(
+    model: &M,
+) -> Result<[Complex<f64>; N], StabilityError> {
+    let (_, a) = state_matrix(model)?;
+    let ev = eigen::eigenvalues(&a).ok_or(StabilityError::NoConvergence)?;
+    check_finite(&ev)?;
+    Ok(ev)
 }
 
 /// Options of [`critical`].

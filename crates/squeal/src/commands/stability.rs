@@ -9,8 +9,9 @@ use crate::run::RunError;
 use crate::ScenarioArgs;
 use clap::Args;
 use squeal_core::stability::Analysis;
+use squeal_study::levers::{lever_keys, Levers};
 use squeal_study::model::AnyModel;
-use squeal_study::stability::{analyse, document, levers_if_searched, searches_levers, shape_of};
+use squeal_study::stability::{analyse, document, shape_of};
 
 /// Arguments of `squeal stability`.
 #[derive(Args, Debug)]
@@ -23,6 +24,10 @@ pub struct StabilityArgs {
     /// Write modes.csv (complex mode shapes of every mode) into this folder.
     #[arg(long)]
     out: Option<std::path::PathBuf>,
+    /// Skip the levers (what would stop it: a search over every parameter,
+    /// seconds for a few hundred dofs).
+    #[arg(long)]
+    no_levers: bool,
 }
 
 /// Write `modes.csv`: one row per mode and position dof,
@@ -88,9 +93,12 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         write_modes_csv(&stage.path("modes.csv"), &sc.model, &an)?;
         stage.commit()?;
     }
-    // Levers need hundreds of analyses: only for models of the fixed-size path.
-    let large = !searches_levers(&sc.model);
-    let levers = levers_if_searched(&sc.model);
+    let levers = if a.no_levers {
+        Levers::none()
+    } else {
+        let bar = crate::run::progress_bar(lever_keys(&sc.model).len() as u64, "searching levers");
+        squeal_study::levers::search(&sc.model, &bar, &crate::run::NEVER)?
+    };
     if a.json {
         let doc = document(&sc, &an, &levers);
         crate::outln!(
@@ -182,26 +190,55 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
             at.join(", ")
         );
     }
-    if large {
+    if !a.no_levers {
+        print_levers(&an, &levers);
+    }
+    Ok(())
+}
+
+/// The levers as text: the ranked changes that flip the verdict with their
+/// windows, the changes that only move the squeal, and the largest
+/// sensitivities.
+fn print_levers(an: &Analysis, lv: &Levers) {
+    let unstable = an.eigen.iter().any(|e| e.growing);
+    if lv.levers.is_empty() {
         crate::outln!(
-            "(levers are searched only for models of up to {} dofs)",
-            squeal_core::model::lumped::MAX_EXACT_DOFS
+            "no single parameter change within ×1000 either way (inside each parameter's physical range) changes the verdict"
         );
-    } else if levers.is_empty() {
-        crate::outln!("no single parameter change within ×1000 either way changes the verdict");
     } else {
         crate::outln!(
-            "{} by changing one parameter (all others as they are):",
-            if !an.eigen.iter().any(|e| e.growing) {
-                "it would start to squeal"
-            } else {
+            "{} by changing one parameter (all others as they are), smallest relative change first:",
+            if unstable {
                 "what would stop it"
+            } else {
+                "it would start to squeal"
             }
         );
-        for l in &levers {
-            let verb = if l.to > l.from { "raise" } else { "lower" };
+        for l in &lv.levers {
+            let rel = l.relative_change();
+            let rel = if rel.is_finite() {
+                format!("{:+.1} %", 100.0 * rel)
+            } else {
+                "from 0".to_string()
+            };
+            let window = if !l.stops {
+                String::new()
+            } else if let Some(u) = l.until {
+                format!(
+                    "; stable until {:.4e} (there the {:.1} Hz mode grows)",
+                    u.value, u.freq_hz
+                )
+            } else if let Some(why) = &l.search_ended {
+                format!("; stable as far as it can go ({why})")
+            } else {
+                format!(
+                    "; stable all the way to {:.4e}, the end of the search",
+                    l.searched_to
+                )
+            };
             crate::outln!(
-                "  {verb} {:<6} from {:<11} to {:.6e} {} (the {:.1} Hz mode crosses there)",
+                "  {} {:<16} from {:<11} to {:.6e} {} ({rel}; the {:.1} Hz mode crosses there){window}",
+                l.way.word(),
                 l.param,
                 format!("{:.4e}", l.from),
                 l.to,
@@ -210,5 +247,53 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
             );
         }
     }
-    Ok(())
+    for m in &lv.moves {
+        let ing = format!("{}ing", m.way.word().trim_end_matches('e'));
+        if m.already_growing {
+            crate::outln!(
+                "  {ing} {} stops the {:.1} Hz mode at {:.4e} {}, but the {:.1} Hz mode, growing already, goes on (σ = {:+.3e} 1/s there)",
+                m.param, m.stops_hz, m.at, m.unit, m.grows_hz, m.growth_rate
+            );
+        } else {
+            crate::outln!(
+                "  {ing} {} only moves the squeal: at {:.4e} {} the {:.1} Hz mode stops growing and the {:.1} Hz mode grows instead (σ = {:+.3e} 1/s)",
+                m.param, m.at, m.unit, m.stops_hz, m.grows_hz, m.growth_rate
+            );
+        }
+    }
+    let mut s: Vec<_> = lv.sensitivities.iter().collect();
+    s.sort_by(|a, b| b.relative.abs().total_cmp(&a.relative.abs()));
+    if !s.is_empty() {
+        crate::outln!(
+            "sensitivity of the {:.2} Hz mode's growth rate (σ = {:+.4e} 1/s) to a 1 % change of each parameter, largest first:",
+            lv.eigenvalue.im / (2.0 * std::f64::consts::PI),
+            lv.eigenvalue.re
+        );
+        let mag = lv.eigenvalue.norm();
+        for x in s.iter().take(10) {
+            crate::outln!(
+                "  {:<16} {}{}",
+                x.param,
+                // Below the eigen-solver's round-off (NEUTRAL_TOL·|λ|): zero.
+                if (0.01 * x.relative).abs() <= squeal_core::stability::NEUTRAL_TOL * mag {
+                    "≈ 0 (round-off)".to_string()
+                } else {
+                    format!("{:+.4e} 1/s", 0.01 * x.relative)
+                },
+                match x.method {
+                    squeal_study::levers::Method::Eigenvectors => "",
+                    squeal_study::levers::Method::Coalescence =>
+                        "  (at a coalescence: one-sided difference)",
+                    squeal_study::levers::Method::Projected =>
+                        "  (difference of the projected eigenvalue)",
+                }
+            );
+        }
+    }
+    if !lv.inert.is_empty() {
+        crate::outln!(
+            "not in steady sliding's linearisation: {}",
+            lv.inert.join(", ")
+        );
+    }
 }
