@@ -308,6 +308,8 @@ struct Ctx<'a> {
     base: Option<&'a (DMatrix<f64>, Vec<Complex<f64>>)>,
     /// Analyses made (the steady state and every eigenvalue).
     count: &'a AtomicUsize,
+    /// Extra analyses left for halving steps while following a mode.
+    halvings: std::cell::Cell<u32>,
 }
 
 impl Ctx<'_> {
@@ -462,6 +464,7 @@ fn scan_direction(
             !w.is_empty()
         }
     };
+    let mut probed = 0;
     'scan: for p in scan_points(start.p, kind, way) {
         let next = match ctx.eval(p) {
             Ok(pt) => pt,
@@ -475,7 +478,15 @@ fn scan_direction(
             }
         };
         let prev = seen.last().expect("the start is seen");
-        let mut between = probe(ctx, prev, &next, PROBE_DEPTH)?;
+        // The nearest gaps first: at most PROBED_GAPS per direction.
+        let mut between = if probed < PROBED_GAPS {
+            probe(ctx, prev, &next, PROBE_DEPTH)?
+        } else {
+            Vec::new()
+        };
+        if !between.is_empty() {
+            probed += 1;
+        }
         between.push(next);
         for next in between {
             let prev = seen.last().expect("the start is seen");
@@ -496,6 +507,7 @@ fn scan_direction(
         }
     }
     let searched_to = seen.last().map_or(start.p, |p| p.p);
+    ctx.halvings.set(FOLLOW_HALVINGS);
     let moved = if windows.is_empty() && start.growing() {
         follow_along(ctx, unit, way, &seen)?
     } else {
@@ -525,6 +537,11 @@ fn scan_direction(
 
 /// How many times [`probe`] halves a scan step.
 const PROBE_DEPTH: u32 = 4;
+/// How many gaps between scan points [`probe`] looks into per direction
+/// (the nearest ones: the windows that need the smallest change).
+const PROBED_GAPS: u32 = 2;
+/// Most step halvings while following a mode along one direction.
+const FOLLOW_HALVINGS: u32 = 16;
 
 /// Between two scan points that both squeal but through different modes
 /// (leading frequencies more than 2 % apart), one mode's growth falls as
@@ -654,7 +671,8 @@ enum Followed {
 }
 
 /// Follow the mode `tr` to the point `b`: the eigenvalue of `b` nearest its
-/// prediction, halving the step (at most 3 times) where that is not clearly
+/// prediction, halving the step (at most 3 times, and at most
+/// [`FOLLOW_HALVINGS`] times along a direction) where that is not clearly
 /// the nearest. Where it stops growing, bisect (on log scale when both ends
 /// have one sign) twenty times for the value where it does (to 1e-6 of
 /// the step).
@@ -662,7 +680,8 @@ fn follow(ctx: &Ctx, tr: &Track, b: &Point, depth: u32) -> Result<Followed, Stud
     let Some((l, clear)) = nearest(&b.ev, tr.predict(b.p)) else {
         return Ok(Followed::Lost);
     };
-    if !clear && depth < 3 {
+    if !clear && depth < 3 && ctx.halvings.get() > 0 {
+        ctx.halvings.set(ctx.halvings.get() - 1);
         let m = match ctx.eval(midpoint(tr.p, b.p)) {
             Ok(m) => m,
             Err(Failed::Interrupted) => return Err(StudyError::Interrupted),
@@ -866,6 +885,7 @@ pub fn search(
                     cancel,
                     base: base.as_ref(),
                     count: &count,
+                    halvings: std::cell::Cell::new(0),
                 };
                 for way in [Way::Raise, Way::Lower] {
                     let d = scan_direction(&ctx, unit, *kind, way, &start)?;
