@@ -290,3 +290,40 @@ fn stability_names_the_real_modes_a_growing_mode_is_made_of() {
         assert!(m["real_modes"][0]["share"].as_f64().unwrap() > 0.98, "{m}");
     }
 }
+
+#[test]
+fn a_real_nastran_punch_gives_nastrans_own_frequencies() {
+    // A punch file written by MSC Nastran 2013 itself (SOL 103, large
+    // field, form 6, `D` exponents, a form-9 VAX to skip), with the
+    // natural frequencies from Nastran's own f06 ("CYCLES", 7 digits,
+    // Givens); see tests/data/msc-nastran-2013/README.md.
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/msc-nastran-2013");
+    let v = json(&squeal(&dir, &["inspect", "beam.toml", "--json"]));
+    assert_eq!(v["dof_count"], 10);
+    assert_eq!(v["matrices"][0]["format"], "dmig");
+    assert_eq!(v["matrices"][1]["nonzeros"], 46);
+    let f: Vec<f64> = v["natural_frequencies_hz"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let nastran = [
+        2.114057e+01,
+        2.135569e+01,
+        1.287332e+02,
+        1.297476e+02,
+        4.371801e+02,
+        4.382013e+02,
+        1.258988e+03,
+        1.259566e+03,
+    ];
+    assert_eq!(f.len(), 10);
+    // The two rigid-body modes: zero to the punch file's ten digits
+    // (√(1e-5)/2π Hz from stiffness round-off of 1e7-sized terms).
+    assert!(f[0].abs() < 1e-3 && f[1].abs() < 1e-3, "{f:?}");
+    for (x, y) in f[2..].iter().zip(nastran) {
+        // The f06 rounds to 7 significant digits: half a unit of the 7th.
+        assert!((x - y).abs() <= 5.01e-7 * y, "{x} against Nastran's {y}");
+    }
+}
