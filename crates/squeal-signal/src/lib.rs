@@ -13,6 +13,7 @@
 //! | [`spectrogram`](mod@spectrogram) | short-time PSD ([`spectrogram()`]) |
 //! | [`envelope`] | FFT Hilbert transform and envelope ([`hilbert_envelope`]) |
 //! | [`growth`] | exponential growth/decay rates ([`fit_growth_rate`], [`growth_rate_linear_part`]) |
+//! | [`line`](mod@line) | one line's frequency over a stretch, with its uncertainty ([`LineSpectrum`]) |
 //! | [`metrics`] | RMS, dominant frequency, [`Verdict`] ([`classify`]) |
 //! | [`verdict`] | the verdict of a whole run and its squeal answer ([`judge`]) |
 //! | [`audio`] | Kaiser-sinc resampling and audio clips ([`render_audio`]) |
@@ -40,6 +41,7 @@ pub mod audio;
 pub mod envelope;
 pub mod error;
 pub mod growth;
+pub mod line;
 pub mod metrics;
 pub mod peaks;
 pub mod spectrogram;
@@ -54,6 +56,7 @@ pub use growth::{
     fit_growth_rate, growth_rate_linear_part, GrowthEstimate, GrowthFit, GrowthOptions, Phase,
     DB_PER_NEPER,
 };
+pub use line::{Line, LineSpectrum};
 pub use metrics::{
     classify, classify_with, dominant_frequency, rms, rms_tail, Classification, Verdict,
     VerdictOptions,

@@ -562,9 +562,20 @@ pub fn integrator_json(run: &Run) -> Value {
 /// The document `summary.json` holds for a run of `sc` analysed as `an`:
 /// the integration (`integrator`, `events`, `stick_fraction`, `t_final`),
 /// `scenario`, `columns`, the tail `rms` of every velocity, `spectrum`,
-/// `growth_rate`, `verdict`, `verdict_detail` and `squeal`. The CLI adds
-/// `audio` and `timing`.
+/// `growth_rate`, `verdict`, `verdict_detail`, `squeal` and `linear` (the
+/// [`Answer`](crate::answer::Answer) of the run). The CLI adds `audio` and
+/// `timing`.
 pub fn summary_json(sc: &Scenario, run: &Run, an: &Analysis) -> Value {
+    summary_json_with(sc, run, an, &crate::answer::Answer::of(sc, run, an))
+}
+
+/// [`summary_json`] with the run's answer already computed.
+pub fn summary_json_with(
+    sc: &Scenario,
+    run: &Run,
+    an: &Analysis,
+    answer: &crate::answer::Answer,
+) -> Value {
     let velocity_names: Vec<String> = {
         let names = sc.model.state_names();
         names[names.len() / 2..].to_vec()
@@ -574,9 +585,10 @@ pub fn summary_json(sc: &Scenario, run: &Run, an: &Analysis) -> Value {
     summary["columns"] = json!(run.columns);
     summary["rms"] = json!(tail_rms(run, &velocity_names));
     summary["spectrum"] = an.spectrum_json();
-    summary["growth_rate"] = an.growth_json();
-    summary["verdict"] = json!(an.verdict.as_str());
-    summary["verdict_detail"] = an.verdict_detail_json();
-    summary["squeal"] = an.squeal_json();
+    summary["growth_rate"] = answer.growth_rate_json(an);
+    summary["verdict"] = json!(answer.verdict(an).as_str());
+    summary["verdict_detail"] = answer.verdict_detail_json(an);
+    summary["squeal"] = answer.squeal_json();
+    summary["linear"] = answer.linear_json();
     summary
 }

@@ -83,6 +83,21 @@ fn terms(l: &Lumped, c: &Combination) -> Vec<(String, f64)> {
 /// zero friction, steady sliding (the closed contacts' stiffness), then
 /// the undamped modes of `M` and the symmetric stiffness.
 fn natural_frequencies(l: &Lumped) -> Result<Vec<f64>, String> {
+    let free = frictionless(l).map_err(|e| e.to_string())?;
+    let z = free.equilibrium_dyn().map_err(|e| e.to_string())?;
+    let sys = free.second_order_dyn(&z);
+    let b = undamped_basis(&sys, Basis::Modes(FREQUENCIES)).map_err(|e| e.to_string())?;
+    Ok(b.omega2
+        .iter()
+        .map(|w2| w2.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
+        .collect())
+}
+
+/// The model with every contact's friction law set to zero friction (the
+/// structure with its contacts' normal stiffness only): its undamped modes
+/// are the brake's real modes, as an FE package's normal-modes run gives
+/// them.
+pub fn frictionless(l: &Lumped) -> Result<Lumped, squeal_core::ParamError> {
     let mut free = l.clone();
     for c in &l.contacts {
         free.set_friction_law(
@@ -91,16 +106,9 @@ fn natural_frequencies(l: &Lumped) -> Result<Vec<f64>, String> {
                 mu_s: 0.0,
                 mu_k: 0.0,
             },
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
     }
-    let z = free.equilibrium_dyn().map_err(|e| e.to_string())?;
-    let sys = free.second_order_dyn(&z);
-    let b = undamped_basis(&sys, Basis::Modes(FREQUENCIES)).map_err(|e| e.to_string())?;
-    Ok(b.omega2
-        .iter()
-        .map(|w2| w2.max(0.0).sqrt() / (2.0 * std::f64::consts::PI))
-        .collect())
+    Ok(free)
 }
 
 /// Inspect a scenario's model.

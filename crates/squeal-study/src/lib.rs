@@ -8,6 +8,7 @@
 //! token and report to a [`Progress`]; failures are [`StudyError`]s.
 
 pub mod analysis;
+pub mod answer;
 pub mod branch;
 pub mod cpu;
 pub mod critical;

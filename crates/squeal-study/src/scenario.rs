@@ -114,18 +114,19 @@ pub fn thesis_sets() -> Vec<Scenario> {
 }
 
 /// Names of the built-in scenarios.
-pub const BUILTINS: [&str; 6] = [
+pub const BUILTINS: [&str; 7] = [
     "disc-pad",
     "belt-coulomb",
     "belt",
     "hoffmann",
     "two-pad-brake",
     "two-pad-brake-asymmetric",
+    "floating-caliper",
 ];
 
-/// The lumped built-ins: the two-pad brake, symmetric and asymmetric (the
-/// files of `scenarios/lumped/`, embedded).
-pub const LUMPED_BUILTINS: [(&str, &str); 2] = [
+/// The lumped built-ins: the two-pad brake, symmetric and asymmetric, and
+/// the 8-dof floating caliper (the files of `scenarios/lumped/`, embedded).
+pub const LUMPED_BUILTINS: [(&str, &str); 3] = [
     (
         "two-pad-brake",
         include_str!("../../../scenarios/lumped/two-pad-brake.toml"),
@@ -133,6 +134,10 @@ pub const LUMPED_BUILTINS: [(&str, &str); 2] = [
     (
         "two-pad-brake-asymmetric",
         include_str!("../../../scenarios/lumped/two-pad-brake-asymmetric.toml"),
+    ),
+    (
+        "floating-caliper",
+        include_str!("../../../scenarios/lumped/floating-caliper.toml"),
     ),
 ];
 

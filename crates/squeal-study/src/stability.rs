@@ -25,7 +25,8 @@ pub fn analyse(model: &AnyModel) -> Result<Analysis, StabilityError> {
 /// The real modes each growing mode of a lumped model is made of
 /// (issue 26 §5): per growing eigenvalue (`+ω` of its pair), its index in
 /// `an.eigen`, its `Composition` over the undamped modes of `M` and the
-/// symmetric stiffness at steady sliding (every mode up to
+/// stiffness at steady sliding without friction (the real modes `squeal
+/// inspect` lists; every mode up to
 /// `modal.dense_max_dofs` dofs, the projection basis above), and the
 /// contact dofs where it moves most (amplitude relative to its largest).
 pub fn coupled_modes(model: &AnyModel, an: &Analysis) -> Vec<CoupledMode> {
@@ -42,12 +43,20 @@ pub fn coupled_modes(model: &AnyModel, an: &Analysis) -> Vec<CoupledMode> {
         return Vec::new();
     }
     let sys = l.second_order_dyn(&an.equilibrium);
+    // The real modes: the structure at steady sliding (its closed contacts'
+    // normal stiffness) without friction, whose symmetric half can make
+    // the stiffness indefinite when μ·k_contact exceeds the structure's
+    // stiffness (and then yields no modes at all).
+    let Ok(free) = crate::inspect::frictionless(l) else {
+        return Vec::new();
+    };
+    let free_sys = free.second_order_dyn(&an.equilibrium);
     let basis = if l.modal.projects(n) {
         l.modal.basis()
     } else {
         Basis::Modes(n)
     };
-    let Ok(basis) = undamped_basis(&sys, basis) else {
+    let Ok(basis) = undamped_basis(&free_sys, basis) else {
         return Vec::new();
     };
     let mut contact_dofs: Vec<usize> = Vec::new();

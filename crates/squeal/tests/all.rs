@@ -2,6 +2,7 @@
 //! library's generic code instead of one per file: issue 24, class 9).
 //! Each file of this folder is a module; a new test file is declared here.
 
+mod answer_cli;
 mod cli;
 mod cli_common;
 mod condense_cli;

@@ -114,10 +114,15 @@ fn short_linear_growth_is_grows_and_too_short_is_said() {
         .as_f64()
         .unwrap();
     assert!((rate - 1.0667).abs() < 0.5, "{rate}");
-    // Four cycles of its 430 Hz normal motion are not enough to tell.
+    // Four cycles of its 430 Hz normal motion are not enough to tell: the
+    // answer is the linear prediction, labelled so (issue 28 §1).
     let s = summary(&["thesis-27", "--duration", "0.01"]);
     assert_eq!(verdict(&s), "too-short", "{}", s["verdict_detail"]);
-    assert!(s["squeal"].is_null());
+    let sq = &s["squeal"];
+    assert_eq!(sq["established"], false, "{sq}");
+    assert_eq!(sq["source"], "linear");
+    assert!((sq["frequency_hz"].as_f64().unwrap() - 5032.92).abs() < 0.01, "{sq}");
+    assert!(sq["rms"].is_null() && sq["lengthen_s"].is_null(), "{sq}");
 }
 
 #[test]
@@ -176,7 +181,7 @@ fn default_squeal_is_the_pad_at_the_least_stable_frequency() {
     // The terminal summary leads with the answer.
     let first = text.lines().next().unwrap();
     assert!(
-        first.starts_with("squeals at 20.75 kHz (pad tangential, x_p)"),
+        first.starts_with("squeals at 20.751 kHz ± 4.0 Hz (pad tangential, x_p)"),
         "{first}"
     );
     let s: Value = serde_json::from_str(

@@ -41,10 +41,15 @@ pub fn run(a: PlotArgs) -> Result<(), RunError> {
     analysis::write_spectrum_csv(&an, &scratch.path("spectrum.csv"))?;
     // summary.json says what the redrawn pictures and spectrum.csv show.
     summary["spectrum"] = an.spectrum_json();
-    summary["growth_rate"] = an.growth_json();
+    // The squeal answer and the growth rates were made with the model's
+    // linear analysis (squeal_study::answer), which a saved run does not
+    // hold: a summary that has them keeps them (the run is the same).
+    if summary.get("linear").is_none() {
+        summary["growth_rate"] = an.growth_json();
+        summary["squeal"] = an.squeal_json();
+    }
     summary["verdict"] = serde_json::json!(an.verdict.as_str());
     summary["verdict_detail"] = an.verdict_detail_json();
-    summary["squeal"] = an.squeal_json();
     output::write_json(&summary, &scratch.path("summary.json"))?;
     crate::staging::replace_files(&a.run_dir, scratch.dir())?;
     crate::outln!(

@@ -142,7 +142,8 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         a.spectrum.signals(),
     );
     analysis::write_spectrum_csv(&an, &stage.path("spectrum.csv"))?;
-    let mut summary = analysis::summary_json(&sc, &run, &an);
+    let answer = squeal_study::answer::Answer::of(&sc, &run, &an);
+    let mut summary = analysis::summary_json_with(&sc, &run, &an, &answer);
     if !a.no_plots {
         analysis::draw(&run, &an, &channels, &sc.name, stage.dir(), &plot_settings)?;
     }
@@ -175,7 +176,13 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
             serde_json::to_string_pretty(&summary).map_err(|e| RunError::Io(e.to_string()))?
         );
     } else {
-        crate::outln!("{}", an.squeal_line(squeal_study::model::coordinate_words));
+        crate::outln!(
+            "{}",
+            answer.squeal_line(&an, squeal_study::model::coordinate_words)
+        );
+        if let Some(g) = answer.growth_line() {
+            crate::outln!("{g}");
+        }
         print_human(&sc, &run, &summary, &dest);
     }
     if let Some(note) = hearing {
@@ -225,7 +232,10 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
             })
             .collect();
         if !dom.is_empty() {
-            crate::outln!("dominant frequencies: {}", dom.join(", "));
+            crate::outln!(
+                "spectral peaks (the strongest line of each velocity, not the squeal answer): {}",
+                dom.join(", ")
+            );
         }
     }
     crate::outln!(
