@@ -10,10 +10,15 @@
 //! | word | rule (checked in this order) |
 //! | --- | --- |
 //! | `out-of-range` | some position leaves `±validity` (m), or a value is not finite: the run left the model's range of validity |
-//! | `lift-off` | contact is lost at least `min_events` times in the judged window, irregularly (intervals between separations vary by more than `regular_cv`) |
+//! | `lift-off` | some contact is lost at least `min_events` times in the judged window, to its end, irregularly (intervals between its separations vary by more than `regular_cv`) |
 //! | `grows` | some moving velocity's level still rises across the judged window: fitted rate `σ > k_se·SE(σ)` and `σ·T > min_change_db` |
-//! | `stick-slip` | true sticks or slip reversals recur through the judged window (at least `min_events` of them, the last within two typical gaps of the end) and nothing grows: a friction-limited cycle |
+//! | `limit-cycle` (contact loss) | some contact loses contact at least `min_events` times through the window, to its end, at regular intervals (coefficient of variation ≤ `regular_cv`), and nothing grows: a cycle with contact loss every period, whatever sticks or reversals come with it — never `stick-slip` |
+//! | `stick-slip` | true sticks or slip reversals recur through the judged window (at least `min_events` of them, the last within two typical gaps of the end), no contact is lost recurrently and nothing grows: a friction-limited cycle |
 //! | `limit-cycle` | the motion neither grows nor decays across the window (within `k_se`·SE or `min_change_db`), after the run's level changed by more than `neutral_db` or with contact events (a cycle the motion was attracted to) |
+//!
+//! Contact loss is decided contact by contact ([`ContactRegime`]): each
+//! contact's own separations, their count and the regularity of their
+//! intervals (two pads' separations interleave).
 //! | `decays` | every moving velocity falls significantly across the window, or has fallen `decayed_db` below its peak, or nothing moves |
 //! | `neutral` | steady, no events at all, and the level at the start of the run equals that at its end within `neutral_db`: undamped linear ringing |
 //! | `too-short` | the judged window holds fewer than `min_cycles` cycles of the motion or too few samples, and the events do not decide: too short to tell |
@@ -303,6 +308,45 @@ pub struct Judgement {
     pub squeal: Option<Squeal>,
     /// Friction events per cycle over the window (when there is a squeal frequency).
     pub cycle: Option<CycleEvents>,
+    /// Each contact's events over the window and its regime (one entry,
+    /// unnamed, when the events name no contact).
+    pub contacts: Vec<ContactRegime>,
+}
+
+/// One contact's events over the judged window and what they make of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactRegime {
+    /// The contact's name (`None` when the events name no contact).
+    pub name: Option<String>,
+    /// True sticks in the window.
+    pub sticks: usize,
+    /// Slip reversals in the window.
+    pub reversals: usize,
+    /// Separations in the window.
+    pub separations: usize,
+    /// Coefficient of variation of the intervals between its separations
+    /// (infinite with fewer than three).
+    pub separation_cv: f64,
+    /// Separations recur to the end of the window (at least `min_events`,
+    /// the last within two typical intervals of the end): contact loss.
+    pub loses_contact: bool,
+    /// Sticks or reversals (at least `min_events`) recur to the end of the
+    /// window: the last within two of its longest gaps of the end.
+    pub friction_cycle: bool,
+}
+
+impl ContactRegime {
+    /// `contact loss` (separations recur), `stick-slip` (sticks or
+    /// reversals recur, contact kept), or `sliding`.
+    pub fn regime(&self) -> &'static str {
+        if self.loses_contact {
+            "contact loss"
+        } else if self.friction_cycle {
+            "stick-slip"
+        } else {
+            "sliding"
+        }
+    }
 }
 
 /// Errors of [`judge`]: inputs that cannot describe a run.
@@ -443,6 +487,7 @@ fn judge_window(run: &RunRecord<'_>, o: &JudgeOptions) -> Result<Judgement, Judg
         trends: Vec::new(),
         squeal: None,
         cycle: None,
+        contacts: Vec::new(),
     };
 
     // 1. Out of range: any position beyond ±validity, or anything non-finite.
@@ -494,11 +539,6 @@ fn judge_window(run: &RunRecord<'_>, o: &JudgeOptions) -> Result<Judgement, Judg
         })
         .map(|e| e.t)
         .collect();
-    let sep_times: Vec<f64> = in_win
-        .iter()
-        .filter(|e| e.kind == EventClass::Separate)
-        .map(|e| e.t)
-        .collect();
     // A regime recurs when there are enough events and the last one is within
     // two typical gaps of the end (the regime has not stopped).
     let recurs = |times: &[f64], count: usize| {
@@ -509,8 +549,64 @@ fn judge_window(run: &RunRecord<'_>, o: &JudgeOptions) -> Result<Judgement, Judg
             })
     };
     let friction_cycle = recurs(&friction_times, sticks + reversals);
-    let lifting = recurs(&sep_times, separations);
-    let sep_cv = gaps(&sep_times).map_or(f64::INFINITY, |g| g.1);
+    // Each contact on its own: separations of two pads interleave, and only
+    // one contact's own intervals say whether it loses contact regularly.
+    let mut names: Vec<Option<&str>> = in_win.iter().map(|e| e.contact).collect();
+    names.sort_unstable();
+    names.dedup();
+    j.contacts = names
+        .iter()
+        .map(|&name| {
+            let of = |pick: &dyn Fn(EventClass) -> bool| -> Vec<f64> {
+                in_win
+                    .iter()
+                    .filter(|e| e.contact == name && pick(e.kind))
+                    .map(|e| e.t)
+                    .collect()
+            };
+            let seps = of(&|k| k == EventClass::Separate);
+            let friction = of(&|k| {
+                matches!(
+                    k,
+                    EventClass::Stick | EventClass::Slip | EventClass::Reverse
+                )
+            });
+            let n_sticks = of(&|k| k == EventClass::Stick).len();
+            let n_reversals = of(&|k| k == EventClass::Reverse).len();
+            ContactRegime {
+                name: name.map(str::to_string),
+                sticks: n_sticks,
+                reversals: n_reversals,
+                separations: seps.len(),
+                separation_cv: gaps(&seps).map_or(f64::INFINITY, |g| g.1),
+                loses_contact: recurs(&seps, seps.len()),
+                // Descriptive only (the verdict reads all contacts' friction
+                // events together): one pad's reversals come in bursts, so
+                // its regime has not stopped while the silence at the end
+                // is shorter than two of its longest gaps.
+                friction_cycle: n_sticks + n_reversals >= o.min_events && friction.len() >= 2 && {
+                    let longest = friction
+                        .windows(2)
+                        .map(|w| w[1] - w[0])
+                        .fold(0.0f64, f64::max);
+                    window.1 - friction[friction.len() - 1] <= 2.0 * longest
+                },
+            }
+        })
+        .collect();
+    let lifting_contacts: Vec<&ContactRegime> =
+        j.contacts.iter().filter(|c| c.loses_contact).collect();
+    let lifting = !lifting_contacts.is_empty();
+    // The least regular of the contacts that lose contact.
+    let worst = lifting_contacts
+        .iter()
+        .copied()
+        .max_by(|a, b| a.separation_cv.total_cmp(&b.separation_cv));
+    let sep_cv = worst.map_or(f64::INFINITY, |c| c.separation_cv);
+    let who = |c: Option<&ContactRegime>| {
+        c.and_then(|c| c.name.as_deref())
+            .map_or(String::new(), |n| format!(" at contact {n}"))
+    };
     let stick_times: Vec<f64> = in_win
         .iter()
         .filter(|e| e.kind == EventClass::Stick)
@@ -601,11 +697,29 @@ fn judge_window(run: &RunRecord<'_>, o: &JudgeOptions) -> Result<Judgement, Judg
         (
             RunVerdict::LiftOff,
             format!(
-                "contact lost {separations} times in the last {span:.4} s, irregularly (interval CV {sep_cv:.2})"
+                "contact lost {} times{} in the last {span:.4} s, irregularly (interval CV {sep_cv:.2})",
+                worst.map_or(separations, |c| c.separations),
+                who(worst)
             ),
         )
     } else if let Some(g) = growing.first() {
         (RunVerdict::Grows, format!("still growing: {}", fmt_rate(g)))
+    } else if lifting {
+        // A contact that separates and recloses every cycle, regularly: a
+        // cycle with contact loss, whatever sticks or reversals come with it.
+        (
+            RunVerdict::LimitCycle,
+            format!(
+                "steady over the last {span:.4} s, losing contact regularly{} ({} times, interval CV {sep_cv:.4}){}: contact loss, not stick-slip",
+                who(worst),
+                worst.map_or(separations, |c| c.separations),
+                if sticks + reversals > 0 {
+                    format!(", with {sticks} true sticks and {reversals} slip reversals")
+                } else {
+                    String::new()
+                }
+            ),
+        )
     } else if friction_cycle {
         (
             RunVerdict::StickSlip,
@@ -645,16 +759,7 @@ fn judge_window(run: &RunRecord<'_>, o: &JudgeOptions) -> Result<Judgement, Judg
     } else {
         (
             RunVerdict::LimitCycle,
-            format!(
-                "steady over the last {span:.4} s{}",
-                if lifting {
-                    format!(
-                        ", losing contact regularly ({separations} times, interval CV {sep_cv:.4})"
-                    )
-                } else {
-                    String::new()
-                }
-            ),
+            format!("steady over the last {span:.4} s"),
         )
     };
     j.verdict = verdict;

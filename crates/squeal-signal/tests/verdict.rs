@@ -260,3 +260,112 @@ fn judge_out_of_range_and_lift_off() {
     }
     assert_eq!(word(&record(&x, &v, fs, events)), RunVerdict::LiftOff);
 }
+
+/// Events `kind` at `contact` every `period` s from `t0` to `end`, with a
+/// recontact (for separations) or a slip a third of a period later.
+fn periodic(
+    kind: EventClass,
+    contact: Option<&'static str>,
+    t0: f64,
+    period: f64,
+    end: f64,
+) -> Vec<RunEvent<'static>> {
+    let mut out = Vec::new();
+    let mut t = t0;
+    while t < end {
+        out.push(RunEvent { t, kind, contact });
+        let back = if kind == EventClass::Separate {
+            EventClass::Contact
+        } else {
+            EventClass::Slip
+        };
+        out.push(RunEvent {
+            t: t + period / 3.0,
+            kind: back,
+            contact,
+        });
+        t += period;
+    }
+    out.sort_by(|a, b| a.t.total_cmp(&b.t));
+    out
+}
+
+#[test]
+fn regular_contact_loss_with_reversals_is_a_limit_cycle_not_stick_slip() {
+    // A 500 Hz cycle that separates once a period and reverses its slip
+    // three times a period (the caliper: 3.3 separations per cycle
+    // were called stick-slip): contact loss names the cycle.
+    let fs = 20_000.0;
+    let (x, v) = osc(|_| 1e-3, 500.0, fs, 0.2);
+    let mut events = periodic(EventClass::Separate, Some("pad"), 0.0005, 0.002, 0.2);
+    events.extend(periodic(
+        EventClass::Reverse,
+        Some("pad"),
+        0.0007,
+        0.002 / 3.0,
+        0.2,
+    ));
+    events.sort_by(|a, b| a.t.total_cmp(&b.t));
+    let j = judge(&record(&x, &v, fs, events), &JudgeOptions::default()).unwrap();
+    assert_eq!(j.verdict, RunVerdict::LimitCycle, "{}", j.reason);
+    assert!(
+        j.reason.contains("losing contact regularly at contact pad")
+            && j.reason.contains("contact loss, not stick-slip"),
+        "{}",
+        j.reason
+    );
+    assert_eq!(j.contacts.len(), 1);
+    let c = &j.contacts[0];
+    assert_eq!(c.regime(), "contact loss");
+    // 0.05 s window: 25 separations, CV ≈ 0 (exactly periodic up to round-off).
+    assert_eq!(c.separations, 25);
+    assert!(c.separation_cv < 1e-9, "{c:?}");
+    let cyc = j.cycle.unwrap();
+    assert!((cyc.separations_per_cycle - 1.0).abs() < 0.05, "{cyc:?}");
+}
+
+#[test]
+fn contacts_are_judged_one_by_one() {
+    // Two pads, each losing contact exactly periodically but at different
+    // rates (every 2 ms and every 3 ms): their separations together are
+    // irregular (the old rule said lift-off); each on its own is regular,
+    // so the run is a limit cycle with contact loss at both.
+    let fs = 20_000.0;
+    let (x, v) = osc(|_| 1e-3, 500.0, fs, 0.2);
+    let mut events = periodic(EventClass::Separate, Some("inner"), 0.0005, 0.002, 0.2);
+    events.extend(periodic(
+        EventClass::Separate,
+        Some("outer"),
+        0.0011,
+        0.003,
+        0.2,
+    ));
+    events.sort_by(|a, b| a.t.total_cmp(&b.t));
+    let j = judge(
+        &record(&x, &v, fs, events.clone()),
+        &JudgeOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(j.verdict, RunVerdict::LimitCycle, "{}", j.reason);
+    let names: Vec<&str> = j
+        .contacts
+        .iter()
+        .map(|c| c.name.as_deref().unwrap())
+        .collect();
+    assert_eq!(names, ["inner", "outer"]);
+    assert!(j.contacts.iter().all(|c| c.regime() == "contact loss"));
+    // Unnamed, the same events are one contact's, irregular: lift-off.
+    let anonymous: Vec<RunEvent> = events
+        .iter()
+        .map(|e| RunEvent {
+            contact: None,
+            ..*e
+        })
+        .collect();
+    assert_eq!(word(&record(&x, &v, fs, anonymous)), RunVerdict::LiftOff);
+    // A pad that slips back and forth but keeps contact is stick-slip.
+    let slips = periodic(EventClass::Reverse, Some("inner"), 0.0005, 0.002, 0.2);
+    let j = judge(&record(&x, &v, fs, slips), &JudgeOptions::default()).unwrap();
+    assert_eq!(j.verdict, RunVerdict::StickSlip, "{}", j.reason);
+    assert_eq!(j.contacts[0].regime(), "stick-slip");
+}

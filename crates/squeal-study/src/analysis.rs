@@ -277,14 +277,19 @@ pub fn state_pairs(run: &Run) -> Vec<(String, String)> {
 }
 
 /// The run's events as the verdict sees them.
-pub fn run_events(run: &Run) -> Vec<RunEvent<'static>> {
+pub fn run_events(run: &Run) -> Vec<RunEvent<'_>> {
     run.events
         .iter()
-        .filter_map(|(t, k)| {
+        .enumerate()
+        .filter_map(|(i, (t, k))| {
             EventClass::from_name(k.as_str()).map(|kind| RunEvent {
                 t: *t,
                 kind,
-                contact: None,
+                contact: run
+                    .event_contacts
+                    .get(i)
+                    .and_then(|&c| run.contact_names.get(c))
+                    .map(String::as_str),
             })
         })
         .collect()
@@ -330,6 +335,7 @@ pub fn judge_run(run: &Run, validity: f64) -> Judgement {
         trends: Vec::new(),
         squeal: None,
         cycle: None,
+        contacts: Vec::new(),
     })
 }
 
@@ -434,11 +440,35 @@ impl Analysis {
                 "separations_per_cycle": c.separations_per_cycle,
             })
         });
+        // Each contact's events over the window, per cycle of the squeal
+        // when there is one, and its regime.
+        let cycles = j.cycle.map(|c| c.cycles).filter(|c| *c > 0.0);
+        let per = |n: usize| cycles.map_or(Value::Null, |c| json!(n as f64 / c));
+        let contacts: Map<String, Value> = j
+            .contacts
+            .iter()
+            .map(|c| {
+                (
+                    c.name.clone().unwrap_or_else(|| "contact".into()),
+                    json!({
+                        "regime": c.regime(),
+                        "sticks": c.sticks,
+                        "reversals": c.reversals,
+                        "separations": c.separations,
+                        "sticks_per_cycle": per(c.sticks),
+                        "reversals_per_cycle": per(c.reversals),
+                        "separations_per_cycle": per(c.separations),
+                        "separation_interval_cv": if c.separation_cv.is_finite() { json!(c.separation_cv) } else { Value::Null },
+                    }),
+                )
+            })
+            .collect();
         json!({
             "verdict": j.verdict.as_str(),
             "reason": j.reason,
             "window_s": [j.window.0, j.window.1],
             "per_cycle": cycle,
+            "contacts": contacts,
             "trends": trends,
         })
     }

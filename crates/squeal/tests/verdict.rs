@@ -121,7 +121,10 @@ fn short_linear_growth_is_grows_and_too_short_is_said() {
     let sq = &s["squeal"];
     assert_eq!(sq["established"], false, "{sq}");
     assert_eq!(sq["source"], "linear");
-    assert!((sq["frequency_hz"].as_f64().unwrap() - 5032.92).abs() < 0.01, "{sq}");
+    assert!(
+        (sq["frequency_hz"].as_f64().unwrap() - 5032.92).abs() < 0.01,
+        "{sq}"
+    );
     assert!(sq["rms"].is_null() && sq["lengthen_s"].is_null(), "{sq}");
 }
 
