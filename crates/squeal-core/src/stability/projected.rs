@@ -121,6 +121,9 @@ pub enum Method {
         dofs: usize,
         /// Undamped frequency of the highest mode kept (Hz).
         basis_max_hz: f64,
+        /// Static-correction vectors added at the contact dofs
+        /// ([`with_static_correction`]).
+        static_vectors: usize,
     },
 }
 
@@ -137,13 +140,143 @@ pub struct SecondOrder {
 }
 
 /// An `M`-orthonormal basis of undamped modes: `Φ` (`n × m`, column `i` is
-/// `φ_i`) and `ω_i²`, ascending.
+/// `φ_i`) and `ω_i²`, ascending; after
+/// [`with_static_correction`], followed by the static-correction vectors
+/// (`static_vectors` columns, `M`-orthonormal to the modes and diagonal in
+/// `K_s`, their Ritz values in `omega2`).
 #[derive(Debug, Clone)]
 pub struct UndampedBasis {
     /// The modes, column-major `n × m`.
     pub phi: faer::Mat<f64>,
-    /// Their `ω²` (rad²/s²), ascending.
+    /// Their `ω²` (rad²/s²), ascending over the modes.
     pub omega2: Vec<f64>,
+    /// How many of the last columns are static-correction vectors.
+    pub static_vectors: usize,
+}
+
+/// The dofs where the linearised coupling is non-symmetric, `K ≠ Kᵀ` or
+/// `C ≠ Cᵀ` beyond round-off: the dofs of the friction contacts (the
+/// follower and friction forces act there).
+pub fn coupling_dofs(sys: &SecondOrder) -> Vec<usize> {
+    let n = sys.m.nrows();
+    let scale = |a: &DMatrix<f64>| a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut on = vec![false; n];
+    for a in [&sys.k, &sys.c] {
+        let tol = 1e-12 * scale(a);
+        for j in 0..n {
+            for i in 0..j {
+                if (a[(i, j)] - a[(j, i)]).abs() > tol {
+                    on[i] = true;
+                    on[j] = true;
+                }
+            }
+        }
+    }
+    (0..n).filter(|&i| on[i]).collect()
+}
+
+/// The basis `b` augmented by the static correction at `dofs` (residual
+/// flexibility; modal truncation augmentation, Dickens, Nakagawa & Wittbrodt
+/// 1997, Comput. Struct. 62; what Nastran's `RESVEC` adds): the static
+/// responses `(K_s + s M)⁻¹ e_j` to a unit load at each dof `j`, with a
+/// small shift `s = (2π · 1 Hz)²` that keeps a free (rigid-body) structure
+/// regular, `M`-orthogonalised against the modes and each other (twice;
+/// responses the basis already holds are dropped), then diagonalised in
+/// `K_s` (Rayleigh–Ritz). The reduced model then represents static loads at
+/// those dofs exactly up to the shift: a truncated basis of modes alone
+/// cannot (a contact's stiffness coupling deforms the structure locally).
+pub fn with_static_correction(
+    sys: &SecondOrder,
+    b: UndampedBasis,
+    dofs: &[usize],
+) -> Result<UndampedBasis, StabilityError> {
+    use faer::linalg::solvers::Solve;
+    use faer::Mat;
+    let n = sys.m.nrows();
+    let m = b.phi.ncols();
+    if dofs.is_empty() || m >= n {
+        return Ok(b);
+    }
+    let shift = (2.0 * std::f64::consts::PI).powi(2);
+    let a = Mat::<f64>::from_fn(n, n, |i, j| {
+        0.5 * (sys.k[(i, j)] + sys.k[(j, i)]) + shift * sys.m[(i, j)]
+    });
+    let lu = a.partial_piv_lu();
+    let mut e = Mat::<f64>::zeros(n, dofs.len());
+    for (c, &j) in dofs.iter().enumerate() {
+        e[(j, c)] = 1.0;
+    }
+    let r = lu.solve(&e);
+    // `M v` once per pass: `uᵀ M v = u · (M v)` for every `u` (M symmetric).
+    let m_times = |v: &[f64]| -> Vec<f64> {
+        (0..n)
+            .map(|i| (0..n).map(|j| sys.m[(i, j)] * v[j]).sum())
+            .collect()
+    };
+    let dot = |x: &[f64], y: &[f64]| -> f64 { x.iter().zip(y).map(|(a, b)| a * b).sum() };
+    let modes: Vec<Vec<f64>> = (0..m)
+        .map(|c| (0..n).map(|i| b.phi[(i, c)]).collect())
+        .collect();
+    let mut kept: Vec<Vec<f64>> = Vec::new();
+    for c in 0..dofs.len() {
+        let mut v: Vec<f64> = (0..n).map(|i| r[(i, c)]).collect();
+        if v.iter().any(|x| !x.is_finite()) {
+            continue;
+        }
+        let norm0 = dot(&v, &m_times(&v)).sqrt();
+        for _ in 0..2 {
+            let mv = m_times(&v);
+            let coefs: Vec<f64> = modes
+                .iter()
+                .chain(kept.iter())
+                .map(|u| dot(u, &mv))
+                .collect();
+            for (u, p) in modes.iter().chain(kept.iter()).zip(coefs) {
+                for (vi, ui) in v.iter_mut().zip(u) {
+                    *vi -= p * ui;
+                }
+            }
+        }
+        let norm = dot(&v, &m_times(&v)).sqrt();
+        if norm > 1e-8 * norm0 && norm.is_finite() {
+            v.iter_mut().for_each(|x| *x /= norm);
+            kept.push(v);
+        }
+    }
+    let r = kept.len();
+    if r == 0 {
+        return Ok(b);
+    }
+    // Rayleigh–Ritz in the static block: Rᵀ K_s R = W Λ Wᵀ (the block is
+    // K_s-orthogonal to the modes, which are eigenvectors).
+    let ks = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (sys.k[(i, j)] + sys.k[(j, i)]));
+    let rm = Mat::<f64>::from_fn(n, r, |i, c| kept[c][i]);
+    let ksr = &ks * &rm;
+    let small = rm.transpose() * &ksr;
+    let small = Mat::<f64>::from_fn(r, r, |i, j| 0.5 * (small[(i, j)] + small[(j, i)]));
+    let evd = small
+        .self_adjoint_eigen(faer::Side::Lower)
+        .map_err(|_| StabilityError::NoConvergence)?;
+    let w = evd.U();
+    let rot = &rm * w;
+    let mut phi = Mat::<f64>::zeros(n, m + r);
+    for c in 0..m {
+        for i in 0..n {
+            phi[(i, c)] = b.phi[(i, c)];
+        }
+    }
+    for c in 0..r {
+        for i in 0..n {
+            phi[(i, m + c)] = rot[(i, c)];
+        }
+    }
+    let mut omega2 = b.omega2;
+    omega2.extend((0..r).map(|i| evd.S()[i]));
+    Ok(UndampedBasis {
+        phi,
+        omega2,
+        static_vectors: r,
+    })
 }
 
 fn to_faer(a: &DMatrix<f64>) -> faer::Mat<f64> {
@@ -253,6 +386,7 @@ pub fn undamped_basis(sys: &SecondOrder, basis: Basis) -> Result<UndampedBasis, 
     Ok(UndampedBasis {
         phi,
         omega2: omega2[..m].to_vec(),
+        static_vectors: 0,
     })
 }
 
@@ -300,12 +434,24 @@ fn reduced_state_matrix(sys: &SecondOrder, b: &UndampedBasis) -> DMatrix<f64> {
 }
 
 fn method(sys: &SecondOrder, b: &UndampedBasis) -> Method {
+    let modes = b.phi.ncols() - b.static_vectors;
     Method::Projected {
-        modes: b.phi.ncols(),
+        modes,
         dofs: sys.m.nrows(),
-        basis_max_hz: b.omega2.last().map_or(0.0, |w2| w2.max(0.0).sqrt())
+        basis_max_hz: b.omega2[..modes]
+            .last()
+            .map_or(0.0, |w2| w2.max(0.0).sqrt())
             / (2.0 * std::f64::consts::PI),
+        static_vectors: b.static_vectors,
     }
+}
+
+/// The projection basis of a friction-coupled system: the undamped modes
+/// `basis` asks for, with the static correction at the dofs where the
+/// coupling is non-symmetric ([`coupling_dofs`], [`with_static_correction`]).
+pub fn corrected_basis(sys: &SecondOrder, basis: Basis) -> Result<UndampedBasis, StabilityError> {
+    let b = undamped_basis(sys, basis)?;
+    with_static_correction(sys, b, &coupling_dofs(sys))
 }
 
 /// The eigenvalues of the projected problem (see the module docs), without
@@ -314,7 +460,7 @@ pub fn projected_eigenvalues(
     sys: &SecondOrder,
     basis: Basis,
 ) -> Result<(Vec<Complex<f64>>, Method), StabilityError> {
-    let b = undamped_basis(sys, basis)?;
+    let b = corrected_basis(sys, basis)?;
     let a = reduced_state_matrix(sys, &b);
     Ok((eigenvalues(&a)?, method(sys, &b)))
 }
@@ -352,7 +498,7 @@ pub fn analyse_projected(
             )));
         }
     }
-    let b = undamped_basis(sys, basis)?;
+    let b = corrected_basis(sys, basis)?;
     let a = reduced_state_matrix(sys, &b);
     let pairs = eigenpairs(&a)?;
     let m = b.phi.ncols();

@@ -74,8 +74,9 @@ fn modal_line(an: &Analysis) -> Option<String> {
             modes,
             dofs,
             basis_max_hz,
+            static_vectors,
         } => Some(format!(
-            "projected onto the {modes} lowest undamped modes of {dofs} dofs (up to {basis_max_hz:.1} Hz): a reduced-basis answer for the modes in that band, none above it (modal.modes / modal.cutoff_hz / modal.dense_max_dofs choose)"
+            "projected onto the {modes} lowest undamped modes of {dofs} dofs (up to {basis_max_hz:.1} Hz) and {static_vectors} static-correction vectors at the contact dofs: a reduced-basis answer for the modes in that band, none above it (modal.modes / modal.cutoff_hz / modal.dense_max_dofs choose)"
         )),
     }
 }
