@@ -95,6 +95,35 @@ impl PlotSettings {
         };
         Ok(PlotSettings { f_range, log_f })
     }
+
+    /// Without `--fmax`/`--frange`, the band that shows a squeal at
+    /// `squeal_hz` and its first two harmonics: 0 to the next 1–2–5 step
+    /// above 3.5 × the squeal, at most the Nyquist frequency `fs/2` (issue
+    /// 28 §5: a 2.25 kHz squeal is not squeezed into a few pixels of
+    /// 0–50 kHz). A range given by flag is kept.
+    pub fn around_squeal(self, squeal_hz: Option<f64>, fs: f64) -> Self {
+        let nyquist = 0.5 * fs;
+        match (self.f_range, squeal_hz) {
+            (None, Some(f)) if f.is_finite() && f > 0.0 => {
+                let want = 3.5 * f;
+                let decade = 10f64.powf(want.log10().floor());
+                let step = [1.0, 2.0, 5.0, 10.0]
+                    .iter()
+                    .map(|k| k * decade)
+                    .find(|&s| s >= want)
+                    .unwrap_or(10.0 * decade);
+                if step >= nyquist {
+                    self
+                } else {
+                    PlotSettings {
+                        f_range: Some((0.0, step)),
+                        ..self
+                    }
+                }
+            }
+            _ => self,
+        }
+    }
 }
 
 /// A prefix scale for values up to `max_abs`: (divisor, prefix) such that the
@@ -291,10 +320,12 @@ pub fn draw(
                         values.push(sg.psd_db[i * nf + k]);
                     }
                 }
-                // A 100 dB scale ending at the next 10 dB above the maximum.
+                // An 80 dB scale ending at the next 10 dB above the
+                // maximum: the squeal and what stands within 80 dB of it,
+                // not the integration's noise floor.
                 let top = (sg.max_db() / 10.0).ceil() * 10.0;
                 let spec = HeatmapSpec {
-                    value_range: Some((top - 100.0, top)),
+                    value_range: Some((top - 80.0, top)),
                     log_y: plot.log_f,
                     ..HeatmapSpec::new(
                         &title,

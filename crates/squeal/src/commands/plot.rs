@@ -37,6 +37,7 @@ pub fn run(a: PlotArgs) -> Result<(), RunError> {
     // Drawn into a scratch folder first; each file then replaces only a file
     // squeal wrote (or none) in the run folder.
     let scratch = crate::staging::Staging::scratch(&a.run_dir)?;
+    let plot = plot.around_squeal(summary["squeal"]["frequency_hz"].as_f64(), run.sample_rate);
     analysis::draw(&run, &an, &channels, &name, scratch.dir(), &plot)?;
     analysis::write_spectrum_csv(&an, &scratch.path("spectrum.csv"))?;
     // summary.json says what the redrawn pictures and spectrum.csv show.

@@ -145,7 +145,11 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
     let answer = squeal_study::answer::Answer::of(&sc, &run, &an);
     let mut summary = analysis::summary_json_with(&sc, &run, &an, &answer);
     if !a.no_plots {
-        analysis::draw(&run, &an, &channels, &sc.name, stage.dir(), &plot_settings)?;
+        let band = plot_settings.around_squeal(
+            answer.squeal.as_ref().map(|s| s.frequency_hz),
+            run.sample_rate,
+        );
+        analysis::draw(&run, &an, &channels, &sc.name, stage.dir(), &band)?;
     }
     let mut hearing = None;
     if a.wav {
