@@ -67,8 +67,8 @@ pub use spectrum::{
     amplitude_spectrum, power_to_db, welch, Scaling, Spectrum, WelchOptions, DB_FLOOR,
 };
 pub use verdict::{
-    judge, ContactRegime, Coordinate, CycleEvents, EventClass, JudgeError, JudgeOptions, Judgement,
-    RunEvent, RunRecord, RunVerdict, Squeal, Trend,
+    gaps, judge, ContactRegime, Coordinate, CycleEvents, EventClass, JudgeError, JudgeOptions,
+    Judgement, RunEvent, RunRecord, RunVerdict, Squeal, Trend,
 };
 pub use window::Window;
 

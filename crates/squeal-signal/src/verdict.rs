@@ -416,8 +416,11 @@ pub fn strongest_line(x: &[f64], fs: f64) -> Option<f64> {
         .map(|p| p.freq)
 }
 
-/// Mean and coefficient of variation of the gaps between consecutive times.
-fn gaps(times: &[f64]) -> Option<(f64, f64)> {
+/// Mean and coefficient of variation of the gaps between consecutive
+/// times (at least three times, a positive mean): the judge's test of a
+/// periodic regime (sticks with CV below 2 % are a strictly periodic stick
+/// cycle; separations with CV above `regular_cv` are irregular).
+pub fn gaps(times: &[f64]) -> Option<(f64, f64)> {
     if times.len() < 3 {
         return None;
     }

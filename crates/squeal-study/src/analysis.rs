@@ -473,32 +473,6 @@ impl Analysis {
         })
     }
 
-    /// The squeal answer in words, for the terminal: "squeals at 20.75 kHz
-    /// (x_p, vx_p RMS 0.708 m/s = −3.0 dB re 1 m/s)", or what the verdict says
-    /// instead.
-    pub fn squeal_line(&self, coordinate_words: impl Fn(&str) -> Option<&'static str>) -> String {
-        let j = &self.judgement;
-        match &j.squeal {
-            Some(s) => {
-                let what = coordinate_words(&s.coordinate)
-                    .map_or(s.coordinate.clone(), |w| format!("{w}, {}", s.coordinate));
-                let verb = if j.verdict == RunVerdict::Grows {
-                    "squeals (still growing)"
-                } else {
-                    "squeals"
-                };
-                format!(
-                    "{verb} at {} ({what}): {} RMS = {:.1} dB re 1 m/s; verdict {}",
-                    si(s.frequency_hz, "Hz", 4),
-                    si(s.rms, "m/s", 3),
-                    s.level_db,
-                    j.verdict
-                )
-            }
-            None => format!("does not squeal: verdict {} ({})", j.verdict, j.reason),
-        }
-    }
-
     /// The `growth_rate` key of summary.json: per velocity, rate (1/s) and window (s).
     pub fn growth_json(&self) -> Value {
         let mut m = Map::new();

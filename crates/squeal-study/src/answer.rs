@@ -7,7 +7,7 @@
 //! ([`AnyModel::eigenvalues`]); the prediction is the most unstable one,
 //! `λ = σ + iω` (the least stable one when none grows).
 //!
-//! **Growth on the modal coordinate** (docs/physics.md §6b). With `y` the
+//! **Growth on the modal coordinate** (docs/physics.md §5e). With `y` the
 //! left eigenvector of the state matrix `A` for `λ` and `z_s` the steady
 //! sliding state, the modal coordinate `q(t) = yᴴ (z(t) − z_s)` obeys
 //! `q̇ = λ q` exactly while the motion is linear (every other mode's right
@@ -22,21 +22,23 @@
 //! **Squeal frequency.** The strongest line of the squealing velocity over
 //! the judged window (`squeal_signal::judge`), one Hann segment zero-padded
 //! ([`LineSpectrum`]), with the uncertainty `1/(2T)` of a window of `T`
-//! seconds. It is *established* when the run has settled (limit cycle,
-//! stick–slip, lift-off), or when it still grows and that line is a growing
-//! eigenvalue's frequency (within three uncertainties or 1 %). Otherwise —
-//! another mode's transient still dominates, or the run ends in its linear
-//! phase — the answer is the linear prediction, labelled so, with an
-//! estimate of how much longer the run must be for the unstable mode to
-//! stand 20 dB above what dominates now: `Δt = (ln(A_other/A_mode) +
-//! ln 10)/σ`.
+//! seconds (a strictly periodic stick cycle with one stick a period: the
+//! integrator's stick times). Where steady sliding is unstable it is
+//! *established* when that line is a growing eigenvalue's frequency: within
+//! three uncertainties or 1 % while the run grows, within 10 % for a settled
+//! cycle (limit cycle, stick–slip, lift-off). Otherwise — another mode's
+//! transient or round-off still dominates, or nothing squeals yet — the
+//! answer is the linear prediction, labelled so; when the run ends in its
+//! linear phase, with an estimate of how much longer it must be for the
+//! unstable mode to stand 20 dB above what dominates now:
+//! `Δt = (ln(A_other/A_mode) + ln 10)/σ`.
 
 use nalgebra::Complex;
 use serde_json::{json, Map, Value};
 use squeal_core::stability::sensitivity::Eigenvectors;
 use squeal_signal::{LineSpectrum, RunVerdict, DB_PER_NEPER};
 
-use crate::analysis::{si, Analysis};
+use crate::analysis::{si, state_pairs, Analysis};
 use crate::model::AnyModel;
 use crate::run::Run;
 use crate::scenario::Scenario;
@@ -63,10 +65,6 @@ pub const SIGNAL_AGREEMENT: f64 = 0.10;
 pub struct Linear {
     /// `λ = σ + iω` with `ω ≥ 0`.
     pub lambda: Complex<f64>,
-    /// How many eigenvalues (counting each conjugate pair once) grow.
-    pub growing: usize,
-    /// The frequencies (Hz) of every growing eigenvalue, most unstable first.
-    pub growing_hz: Vec<f64>,
     /// The state coordinate where the mode's velocity is largest (`vx_p`).
     pub velocity: Option<String>,
     /// Every eigenvalue with `ω ≥ 0`.
@@ -82,6 +80,13 @@ impl Linear {
     pub fn freq_hz(&self) -> f64 {
         self.lambda.im / std::f64::consts::TAU
     }
+    /// The frequencies (Hz) of every growing eigenvalue (each conjugate
+    /// pair once), most unstable first.
+    pub fn growing_hz(&self) -> Vec<f64> {
+        let mut g: Vec<Complex<f64>> = self.all.iter().copied().filter(|e| e.re > 0.0).collect();
+        g.sort_by(|a, b| b.re.total_cmp(&a.re));
+        g.iter().map(|e| e.im / std::f64::consts::TAU).collect()
+    }
 }
 
 /// The growth rate measured on the modal coordinate.
@@ -95,6 +100,18 @@ pub struct ModalGrowth {
     pub relative_difference: Option<f64>,
     /// Why no rate is given.
     pub reason: Option<String>,
+}
+
+impl ModalGrowth {
+    /// Whether the measured linear phase lasts to the run's last sample
+    /// (within two samples).
+    pub fn reaches_end(&self, run: &Run) -> bool {
+        let end = run.column("t").and_then(|t| t.last().copied());
+        match (self.rate, self.window, end) {
+            (Some(_), Some((_, t1)), Some(end)) => end - t1 <= 2.0 / run.sample_rate,
+            _ => false,
+        }
+    }
 }
 
 /// Where the squeal frequency comes from.
@@ -163,8 +180,8 @@ pub struct Answer {
     pub verdict: Option<(RunVerdict, String)>,
 }
 
-/// Index of the most unstable eigenvalue (largest real part; among equals,
-/// the one with `ω ≥ 0`).
+/// The most unstable eigenvalue with `ω ≥ 0` (largest real part; among
+/// equals, the lowest frequency).
 fn leading(ev: &[Complex<f64>]) -> Option<Complex<f64>> {
     ev.iter()
         .copied()
@@ -191,9 +208,11 @@ impl Answer {
             verdict: None,
         };
         let names = sc.model.state_names();
+        // One steady-sliding solve and one state matrix: its eigenvalues
+        // and the leading one's eigenvectors.
         let eig = sc.model.state_matrix().map(|r| {
             r.and_then(|(z, a)| {
-                let ev = sc.model.eigenvalues()?;
+                let ev = squeal_core::stability::modal::eigenvalues(&a)?;
                 Ok((z, a, ev))
             })
         });
@@ -209,12 +228,6 @@ impl Answer {
                 None
             }
             Some(Ok((z, a, ev))) => leading(&ev).map(|lambda| {
-                let mut growing: Vec<Complex<f64>> = ev
-                    .iter()
-                    .copied()
-                    .filter(|e| e.re > 0.0 && e.im >= 0.0)
-                    .collect();
-                growing.sort_by(|a, b| b.re.total_cmp(&a.re));
                 let vectors = Eigenvectors::of(&a, lambda);
                 let n = names.len() / 2;
                 let velocity = vectors.as_ref().and_then(|v| {
@@ -224,11 +237,6 @@ impl Answer {
                 });
                 answer.linear = Some(Linear {
                     lambda,
-                    growing: growing.len(),
-                    growing_hz: growing
-                        .iter()
-                        .map(|e| e.im / std::f64::consts::TAU)
-                        .collect(),
                     velocity,
                     all: ev.iter().copied().filter(|e| e.im >= 0.0).collect(),
                 });
@@ -248,15 +256,15 @@ impl Answer {
                 },
             });
         }
-        answer.verdict = still_linear(run, an, answer.linear.as_ref(), answer.growth.as_ref());
-        let verdict = answer.verdict(an);
-        answer.squeal = squeal_answer(
-            run,
+        let linear_to_end = answer.growth.as_ref().is_some_and(|g| g.reaches_end(run));
+        answer.verdict = still_linear(
             an,
-            verdict,
             answer.linear.as_ref(),
             answer.growth.as_ref(),
+            linear_to_end,
         );
+        let verdict = answer.verdict(an);
+        answer.squeal = squeal_answer(run, an, verdict, answer.linear.as_ref(), linear_to_end);
         // A steady run whose steady line is not the unstable mode's: the
         // run ended before the squeal showed.
         if let Some(s) = answer
@@ -330,12 +338,13 @@ impl Answer {
             return json!({ "eigenvalue": null, "reason": self.linear_reason });
         };
         let g = self.growth.as_ref();
+        let growing_hz = l.growing_hz();
         json!({
             "eigenvalue": { "re": l.lambda.re, "im": l.lambda.im },
             "growth_rate": l.growth_rate(),
             "freq_hz": l.freq_hz(),
-            "growing_modes": l.growing,
-            "growing_hz": l.growing_hz,
+            "growing_modes": growing_hz.len(),
+            "growing_hz": growing_hz,
             "velocity": l.velocity,
             "measured_growth": g.map_or(Value::Null, |g| json!({
                 "rate": g.rate,
@@ -588,19 +597,15 @@ fn modal_growth(
 /// short while its unstable mode's own coordinate grows at the eigenvalue's
 /// rate to the end of the run.
 fn still_linear(
-    run: &Run,
     an: &Analysis,
     lin: Option<&Linear>,
     growth: Option<&ModalGrowth>,
+    to_end: bool,
 ) -> Option<(RunVerdict, String)> {
     let l = lin.filter(|l| l.growth_rate() > 0.0)?;
     let g = growth?;
     let (rate, (t0, t1)) = (g.rate?, g.window?);
-    let t = run.column("t")?;
-    let end = *t.last()?;
-    let dt = 1.0 / run.sample_rate;
     let j = &an.judgement;
-    let to_end = end - t1 <= 2.0 * dt;
     let contradicted = matches!(
         j.verdict,
         RunVerdict::LimitCycle | RunVerdict::Neutral | RunVerdict::TooShort | RunVerdict::Decays
@@ -626,9 +631,23 @@ fn squeal_answer(
     an: &Analysis,
     verdict: RunVerdict,
     lin: Option<&Linear>,
-    growth: Option<&ModalGrowth>,
+    linear_to_end: bool,
 ) -> Option<SquealAnswer> {
     let j = &an.judgement;
+    // σ says how much longer to run only while the run is still linear at
+    // its end: no event in the judged window, the modal coordinate measured
+    // to the last sample.
+    let quiet = !run
+        .events
+        .iter()
+        .any(|e| e.0 >= j.window.0 && e.0 <= j.window.1);
+    let end = if quiet && linear_to_end {
+        RunEnd::Linear
+    } else if quiet {
+        RunEnd::Unmeasured
+    } else {
+        RunEnd::Nonlinear
+    };
     let fs = run.sample_rate;
     let n = run.len();
     let i0 = n
@@ -652,10 +671,11 @@ fn squeal_answer(
         let line = spectrum_of(&s.velocity)
             .and_then(|sp| sp.strongest(None))
             .map_or((s.frequency_hz, None), |l| (l.freq, Some(l.uncertainty)));
-        let sticks = stick_frequency(run, j.window).filter(|&(fs, _)| {
-            verdict == RunVerdict::StickSlip && line.1.is_some_and(|u| (fs - line.0).abs() <= u)
+        let sticks = stick_frequency(run, j.window).filter(|&(f_stick, _)| {
+            verdict == RunVerdict::StickSlip
+                && line.1.is_some_and(|u| (f_stick - line.0).abs() <= u)
         });
-        let (f, u) = sticks.map_or(line, |(fs, us)| (fs, Some(us)));
+        let (f, u) = sticks.map_or(line, |(f_stick, u_stick)| (f_stick, Some(u_stick)));
         // A settled cycle's frequency may drift from its mode's linear one
         // (10 %); a growing run's line is the mode's (three uncertainties
         // or 1 %).
@@ -667,9 +687,8 @@ fn squeal_answer(
             }
         };
         let matched = unstable.and_then(|l| {
-            l.growing_hz
-                .iter()
-                .copied()
+            l.growing_hz()
+                .into_iter()
                 .find(|&g| (f - g).abs() <= tol(g))
         });
         let established = unstable.is_none() || matched.is_some();
@@ -695,13 +714,10 @@ fn squeal_answer(
         }
         // The line is not a growing mode's: another mode's transient (or
         // the integration's noise) still dominates the window.
-        return unstable.map(|l| not_yet(run, an, l, spectrum_of, true));
+        return unstable.map(|l| not_yet(run, an, l, spectrum_of, end));
     }
     // Nothing squeals in the run although steady sliding is unstable: the
-    // squeal is not there yet. When the run ends in its linear phase (no
-    // event in the judged window, the modal coordinate measured to the
-    // end), σ says how much longer to run; otherwise the run has left its
-    // linear phase and not settled by its end.
+    // squeal is not there yet.
     let l = unstable?;
     if !matches!(
         verdict,
@@ -709,23 +725,26 @@ fn squeal_answer(
     ) {
         return None;
     }
-    let quiet = !run
-        .events
-        .iter()
-        .any(|e| e.0 >= j.window.0 && e.0 <= j.window.1);
-    let end = run
-        .column("t")
-        .and_then(|t| t.last().copied())
-        .unwrap_or(0.0);
-    let linear_to_end = growth
-        .and_then(|g| g.rate.and(g.window))
-        .is_some_and(|w| end - w.1 <= 2.0 / fs);
-    Some(not_yet(run, an, l, spectrum_of, quiet && linear_to_end))
+    Some(not_yet(run, an, l, spectrum_of, end))
+}
+
+/// How a run that has not shown its squeal ends.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RunEnd {
+    /// In its linear phase, the mode's growth measured to the end: σ says
+    /// how much longer to run.
+    Linear,
+    /// No contact event at its end, but the mode's coordinate not
+    /// measurable (unexcited, at round-off).
+    Unmeasured,
+    /// Contact events at its end: nonlinear and not settled.
+    Nonlinear,
 }
 
 /// The frequency of a strictly periodic stick cycle over `window` (the
-/// judge's rule: gaps between true sticks with a coefficient of variation
-/// below 2 %) and its standard error `f²·sd(T)/√n`.
+/// judge's rule, [`squeal_signal::gaps`]: gaps between true sticks with a
+/// coefficient of variation below 2 %) and its standard error
+/// `f²·sd(T)/√n`.
 fn stick_frequency(run: &Run, window: (f64, f64)) -> Option<(f64, f64)> {
     let times: Vec<f64> = run
         .events
@@ -735,28 +754,27 @@ fn stick_frequency(run: &Run, window: (f64, f64)) -> Option<(f64, f64)> {
         })
         .map(|e| e.0)
         .collect();
-    if times.len() < 3 {
-        return None;
-    }
-    let gaps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
-    let n = gaps.len() as f64;
-    let mean = gaps.iter().sum::<f64>() / n;
-    let sd = (gaps.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / n).sqrt();
-    (mean > 0.0 && sd / mean < 0.02).then(|| (1.0 / mean, sd / (mean * mean) / n.sqrt()))
+    let (mean, cv) = squeal_signal::gaps(&times).filter(|g| g.1 < 0.02)?;
+    let n = (times.len() - 1) as f64;
+    Some((1.0 / mean, cv / mean / n.sqrt()))
 }
 
-/// The linear prediction, labelled so, with how much longer to run (when
-/// the run is still `linear` at its end; otherwise that cannot be told from
+/// The linear prediction, labelled so, with how much longer to run when
+/// the run is still linear at its end (otherwise that cannot be told from
 /// `σ`).
 fn not_yet(
     run: &Run,
     an: &Analysis,
     l: &Linear,
     spectrum_of: impl Fn(&str) -> Option<LineSpectrum>,
-    linear: bool,
+    end: RunEnd,
 ) -> SquealAnswer {
+    let pairs = state_pairs(run);
     let velocity = l.velocity.clone().unwrap_or_default();
-    let coordinate = velocity.strip_prefix('v').unwrap_or(&velocity).to_string();
+    let coordinate = pairs
+        .iter()
+        .find(|p| p.1 == velocity)
+        .map_or(velocity.clone(), |p| p.0.clone());
     let f_lin = l.freq_hz();
     let sigma = l.growth_rate();
     let sp = spectrum_of(&velocity);
@@ -780,7 +798,7 @@ fn not_yet(
         .iter()
         .filter(|t| t.moving)
         .max_by(|a, b| a.rms.total_cmp(&b.rms))
-        .map(|t| format!("v{}", t.name));
+        .and_then(|t| pairs.iter().find(|p| p.0 == t.name).map(|p| p.1.clone()));
     let dominant_hz = loudest
         .and_then(|v| spectrum_of(&v))
         .and_then(|s| s.strongest(None))
@@ -790,14 +808,16 @@ fn not_yet(
         .column("t")
         .and_then(|t| t.last().copied())
         .unwrap_or(0.0);
-    let advice = if linear {
-        format!(
+    let advice = match end {
+        RunEnd::Linear => format!(
             "lengthen the run by about {} ({:.1} dB more growth, estimated from σ and the levels at the end of the run) to hear it",
             si(lengthen, "s", 3),
             nepers * DB_PER_NEPER
-        )
-    } else {
-        "the run is not in its linear phase at its end and has not settled: lengthen it until its last quarter is steady (how much cannot be told from σ once the motion is nonlinear)".to_string()
+        ),
+        RunEnd::Unmeasured => format!(
+            "the mode is too weakly excited to measure here (unexcited, or at the integration's round-off): give it a start (an offset on {coordinate}) or lengthen the run; how much longer cannot be told from so weak a start"
+        ),
+        RunEnd::Nonlinear => "the run is not in its linear phase at its end and has not settled: lengthen it until its last quarter is steady (how much cannot be told from σ once the motion is nonlinear)".to_string(),
     };
     let note = format!(
         "the squeal is not established by the end of the run ({duration:.4} s): the linear prediction is {} (σ = {sigma:+.4e} 1/s, e-fold time {:.3} s){}; {advice}",
@@ -819,7 +839,7 @@ fn not_yet(
         level_db: None,
         linear_hz: Some(f_lin),
         dominant_hz,
-        lengthen_s: linear.then_some(lengthen),
+        lengthen_s: (end == RunEnd::Linear).then_some(lengthen),
         note,
     }
 }

@@ -198,10 +198,8 @@ pub fn with_static_correction(
         return Ok(b);
     }
     let shift = (2.0 * std::f64::consts::PI).powi(2);
-    let a = Mat::<f64>::from_fn(n, n, |i, j| {
-        0.5 * (sys.k[(i, j)] + sys.k[(j, i)]) + shift * sys.m[(i, j)]
-    });
-    let lu = a.partial_piv_lu();
+    let ks = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (sys.k[(i, j)] + sys.k[(j, i)]));
+    let lu = Mat::<f64>::from_fn(n, n, |i, j| ks[(i, j)] + shift * sys.m[(i, j)]).partial_piv_lu();
     let mut e = Mat::<f64>::zeros(n, dofs.len());
     for (c, &j) in dofs.iter().enumerate() {
         e[(j, c)] = 1.0;
@@ -249,7 +247,6 @@ pub fn with_static_correction(
     }
     // Rayleigh–Ritz in the static block: Rᵀ K_s R = W Λ Wᵀ (the block is
     // K_s-orthogonal to the modes, which are eigenvectors).
-    let ks = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (sys.k[(i, j)] + sys.k[(j, i)]));
     let rm = Mat::<f64>::from_fn(n, r, |i, c| kept[c][i]);
     let ksr = &ks * &rm;
     let small = rm.transpose() * &ksr;
