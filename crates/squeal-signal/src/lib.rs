@@ -15,6 +15,7 @@
 //! | [`growth`] | exponential growth/decay rates ([`fit_growth_rate`], [`growth_rate_linear_part`]) |
 //! | [`line`](mod@line) | one line's frequency over a stretch, with its uncertainty ([`LineSpectrum`]) |
 //! | [`metrics`] | RMS, dominant frequency, [`Verdict`] ([`classify`]) |
+//! | [`radiation`] | equivalent radiated power, sound pressure, A-weighting ([`Listener`]) |
 //! | [`verdict`] | the verdict of a whole run and its squeal answer ([`judge`]) |
 //! | [`audio`] | Kaiser-sinc resampling and audio clips ([`render_audio`]) |
 //!
@@ -44,6 +45,7 @@ pub mod growth;
 pub mod line;
 pub mod metrics;
 pub mod peaks;
+pub mod radiation;
 pub mod spectrogram;
 pub mod spectrum;
 pub mod verdict;
@@ -62,6 +64,7 @@ pub use metrics::{
     VerdictOptions,
 };
 pub use peaks::{find_peaks, parabolic_vertex, window_response, Peak, PeakOptions};
+pub use radiation::{a_weighting_db, mean_squares, Levels, Listener, Space};
 pub use spectrogram::{spectrogram, Spectrogram};
 pub use spectrum::{
     amplitude_spectrum, power_to_db, welch, Scaling, Spectrum, WelchOptions, DB_FLOOR,

@@ -5,5 +5,6 @@
 mod audio;
 mod common;
 mod growth;
+mod radiation;
 mod spectrum;
 mod verdict;

@@ -567,7 +567,8 @@ pub fn integrator_json(run: &Run) -> Value {
 /// the integration (`integrator`, `events`, `stick_fraction`, `t_final`),
 /// `scenario`, `columns`, the tail `rms` of every velocity, `spectrum`,
 /// `growth_rate`, `verdict`, `verdict_detail`, `squeal` and `linear` (the
-/// [`Answer`](crate::answer::Answer) of the run). The CLI adds `audio` and
+/// [`Answer`](crate::answer::Answer) of the run), and `radiation` (its
+/// sound over the judged window, [`crate::radiation`]). The CLI adds `audio` and
 /// `timing`.
 pub fn summary_json(sc: &Scenario, run: &Run, an: &Analysis) -> Value {
     summary_json_with(sc, run, an, &crate::answer::Answer::of(sc, run, an))
@@ -594,5 +595,9 @@ pub fn summary_json_with(
     summary["verdict_detail"] = answer.verdict_detail_json(an);
     summary["squeal"] = answer.squeal_json();
     summary["linear"] = answer.linear_json();
+    summary["radiation"] = crate::radiation::radiation_json(
+        &answer.sound,
+        answer.squeal.as_ref().map(|s| s.coordinate.as_str()),
+    );
     summary
 }

@@ -40,6 +40,7 @@ use squeal_signal::{LineSpectrum, RunVerdict, DB_PER_NEPER};
 
 use crate::analysis::{si, state_pairs, Analysis};
 use crate::model::AnyModel;
+use crate::radiation::Sound;
 use crate::run::Run;
 use crate::scenario::Scenario;
 
@@ -178,6 +179,9 @@ pub struct Answer {
     /// end (its linear phase), which the signal's level alone cannot
     /// resolve over the judged window.
     pub verdict: Option<(RunVerdict, String)>,
+    /// The run's sound over the judged window, from the scenario's
+    /// radiating surfaces ([`crate::radiation`]); the reason when there is none.
+    pub sound: Result<Sound, String>,
 }
 
 /// The most unstable eigenvalue with `ω ≥ 0` (largest real part; among
@@ -206,6 +210,7 @@ impl Answer {
             growth: None,
             squeal: None,
             verdict: None,
+            sound: Sound::of(&sc.radiation, run, an.judgement.window),
         };
         let names = sc.model.state_names();
         // One steady-sliding solve and one state matrix: its eigenvalues

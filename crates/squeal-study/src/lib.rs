@@ -23,6 +23,7 @@ pub mod map;
 pub mod matrix_file;
 pub mod memory;
 pub mod model;
+pub mod radiation;
 pub mod reproduce;
 pub mod run;
 pub mod scenario;

@@ -195,6 +195,10 @@ pub struct Outcome {
     pub stick_fraction: f64,
     /// Time the run ended (early once the class is certain).
     pub t_end: f64,
+    /// A-weighted sound pressure level (dB(A) re 20 µPa) over the last
+    /// window, from the scenario's radiating surfaces ([`crate::radiation`]);
+    /// NaN without surfaces or motion.
+    pub spl_dba: f64,
 }
 
 impl Outcome {
@@ -204,6 +208,7 @@ impl Outcome {
         rms: f64::NAN,
         stick_fraction: f64::NAN,
         t_end: f64::NAN,
+        spl_dba: f64::NAN,
     };
 }
 
@@ -226,6 +231,13 @@ struct Watch {
     decided: Option<&'static str>,
     /// The scenario's validity bound (m): a position beyond it ends the run `out-of-range`.
     validity: f64,
+    /// The radiating surfaces' state indices (their velocities).
+    surfaces: Vec<usize>,
+    /// Their velocities over the current window, interleaved (capacity
+    /// reserved for a whole window: no allocation while running).
+    current: Vec<f64>,
+    /// The same over the last complete window.
+    last: Vec<f64>,
 }
 
 impl<const N: usize> Sink<N> for Watch {
@@ -241,10 +253,17 @@ impl<const N: usize> Sink<N> for Watch {
         self.cur_max = self.cur_max.max(a);
         self.sum2 += z[self.v_idx] * z[self.v_idx];
         self.count += 1;
+        if self.current.len() + self.surfaces.len() <= self.current.capacity() {
+            for &i in &self.surfaces {
+                self.current.push(z[i]);
+            }
+        }
         if t < self.next {
             return Flow::Continue;
         }
         self.next = t + self.window;
+        std::mem::swap(&mut self.current, &mut self.last);
+        self.current.clear();
         let amp = self.cur_max;
         self.last_rms = (self.sum2 / self.count.max(1) as f64).sqrt();
         self.amps.push(amp);
@@ -287,6 +306,14 @@ fn watch_for<M: System<N>, const N: usize>(
     let v_idx = *idx.first().ok_or("no tangential velocity")?;
     let z0 = crate::run::initial_of(model, sc).map_err(|e| e.to_string())?;
     let window = sc.duration / 50.0;
+    let surfaces: Vec<usize> = sc
+        .radiation
+        .areas
+        .iter()
+        .filter_map(|(dof, _)| names.iter().position(|n| n == dof).map(|i| i + N / 2))
+        .collect();
+    // A window's samples, and a few more for the sample that closes it.
+    let room = ((window * sc.sample_rate).ceil() as usize + 4) * surfaces.len();
     let w = Watch {
         idx,
         v_idx,
@@ -302,12 +329,44 @@ fn watch_for<M: System<N>, const N: usize>(
         peak: 0.0,
         decided: None,
         validity: sc.validity,
+        surfaces,
+        current: Vec::with_capacity(room),
+        last: Vec::with_capacity(room),
     };
     Ok((w, z0))
 }
 
+/// The A-weighted level of the last complete window of `w`'s surfaces
+/// (NaN when there is none, or it is silent).
+fn last_window_dba(w: &Watch, sc: &Scenario) -> f64 {
+    let k = w.surfaces.len();
+    if k == 0 || w.last.len() < 2 * k {
+        return f64::NAN;
+    }
+    let columns: Vec<Vec<f64>> = (0..k)
+        .map(|j| w.last.iter().skip(j).step_by(k).copied().collect())
+        .collect();
+    let surfaces: Vec<(f64, &[f64])> = sc
+        .radiation
+        .areas
+        .iter()
+        .zip(&columns)
+        .map(|((_, a), c)| (*a, c.as_slice()))
+        .collect();
+    let l = sc.radiation.listener().levels(&surfaces, sc.sample_rate);
+    if l.spl_dba.is_finite() {
+        l.spl_dba
+    } else {
+        f64::NAN
+    }
+}
+
 /// The outcome of a watched run that ended with `info`.
-fn classify(w: &Watch, info: Result<RunInfo, IntegrateError>) -> Result<Outcome, String> {
+fn classify(
+    w: &Watch,
+    sc: &Scenario,
+    info: Result<RunInfo, IntegrateError>,
+) -> Result<Outcome, String> {
     let info = info.map_err(|e| e.to_string())?;
     let class = w.decided.unwrap_or_else(|| {
         let n = w.amps.len();
@@ -331,6 +390,7 @@ fn classify(w: &Watch, info: Result<RunInfo, IntegrateError>) -> Result<Outcome,
         rms: w.last_rms,
         stick_fraction: info.stats.stick_fraction(),
         t_end: info.t_final,
+        spl_dba: last_window_dba(w, sc),
     })
 }
 
@@ -350,7 +410,7 @@ fn transient_point<M: System<N>, const N: usize>(
         crate::run::sim_options::<N>(sc),
         &mut w,
     );
-    classify(&w, info)
+    classify(&w, sc, info)
 }
 
 /// Transient map over `points` (flat indices, see [`point`]): one
@@ -466,12 +526,12 @@ fn run_lanes<M: LaneField<N>, const N: usize>(
                 opts: crate::run::sim_options::<N>(s),
                 sink,
             });
-            slots.push(n);
+            slots.push((n, s));
         }
     }
     let results = simulate_ensemble_lanes(&mut jobs, sample_rate);
-    for ((job, r), n) in jobs.iter().zip(results).zip(slots) {
-        out[n] = classify(&job.sink, r).unwrap_or(Outcome::FAILED);
+    for ((job, r), (n, s)) in jobs.iter().zip(results).zip(slots) {
+        out[n] = classify(&job.sink, s, r).unwrap_or(Outcome::FAILED);
     }
 }
 

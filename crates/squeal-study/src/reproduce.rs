@@ -79,6 +79,13 @@ pub struct SetResult {
     pub normal_power: Option<(f64, f64)>,
     /// Envelope rate (1/s) of the disc's normal velocity at its peak frequency.
     pub normal_rate: Option<f64>,
+    /// The equivalent radiated power (dB re 1 pW) over the judged window,
+    /// from the scenario's radiating surfaces ([`crate::radiation`]); `None`
+    /// when there are none or nothing moves them.
+    pub erp_db: Option<f64>,
+    /// The A-weighted sound pressure level (dB(A) re 20 µPa) at the
+    /// scenario's distance, likewise.
+    pub spl_dba: Option<f64>,
 }
 
 /// The answer to "does it squeal, at which frequency, how loud".
@@ -271,7 +278,11 @@ pub fn measure_run<E: From<StudyError>>(
         study::envelope_rate(&b, 0.0, sc.duration)
     });
     let total: f64 = stats.mode_time.iter().sum();
+    let sound = crate::radiation::Sound::of(&sc.radiation, &run, an.judgement.window).ok();
+    let finite = |x: f64| x.is_finite().then_some(x);
     Ok(SetResult {
+        erp_db: sound.as_ref().and_then(|s| finite(s.levels.erp_db)),
+        spl_dba: sound.as_ref().and_then(|s| finite(s.levels.spl_dba)),
         id,
         linear,
         linear_note,
@@ -1062,6 +1073,8 @@ pub mod exact {
             })),
             "normal_power": r.normal_power.map_or(Value::Null, |(a, b)| json!([x(a), x(b)])),
             "normal_rate": ox(r.normal_rate),
+            "erp_db": ox(r.erp_db),
+            "spl_dba": ox(r.spl_dba),
         })
     }
 
@@ -1172,6 +1185,8 @@ pub mod exact {
                 p => Some((gx(&p[0], "normal_power")?, gx(&p[1], "normal_power")?)),
             },
             normal_rate: gox(&v["normal_rate"], "normal_rate")?,
+            erp_db: gox(&v["erp_db"], "erp_db")?,
+            spl_dba: gox(&v["spl_dba"], "spl_dba")?,
             sc,
         })
     }
@@ -1243,6 +1258,8 @@ mod tests {
             }),
             normal_power: Some((7.0, 8.0)),
             normal_rate: None,
+            erp_db: Some(61.25),
+            spl_dba: None,
         };
         let j = exact::to_json(&r);
         let b = exact::from_json(&j, sc.clone()).unwrap();

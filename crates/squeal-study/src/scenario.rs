@@ -7,6 +7,7 @@
 
 use crate::lumped_file::{MatrixFiles, LUMPED_KEYS};
 use crate::model::{AnyModel, MODEL_NAMES};
+use crate::radiation::Radiation;
 use serde_json::{json, Map, Value};
 use squeal_core::friction::LAW_NAMES;
 use squeal_core::initial::Initial;
@@ -58,6 +59,8 @@ pub struct Scenario {
     pub solver: SolverOptions,
     /// A lumped model's matrix files (for `scenario show`).
     pub matrices: MatrixFiles,
+    /// The radiating surfaces and the listener (`[radiation]`, docs/physics.md §5f).
+    pub radiation: Radiation,
 }
 
 /// The 40 reconstructed sets of Table 11.1, embedded so that the command
@@ -147,6 +150,7 @@ impl Scenario {
         let base = |model: AnyModel, description: &str| Scenario {
             name: name.to_string(),
             description: description.to_string(),
+            radiation: Radiation::default_for(&model),
             offsets: vec![0.0; model.state_names().len()],
             model,
             duration: 0.5,
@@ -317,6 +321,7 @@ impl Scenario {
         let mut s = Scenario {
             name: "scenario".into(),
             description: String::new(),
+            radiation: Radiation::default_for(&model),
             offsets: vec![0.0; model.state_names().len()],
             model,
             duration: 0.5,
@@ -347,6 +352,36 @@ impl Scenario {
                         })?;
                         s.apply_in("params", &format!("modal.{k}"), &setting)?;
                     }
+                }
+                ("radiation", toml::Value::Table(t)) => {
+                    for (k, v) in t {
+                        match (k.as_str(), v) {
+                            ("area_m2", toml::Value::Table(areas)) => {
+                                for (dof, a) in areas {
+                                    let setting = Setting::from_toml(a).ok_or_else(|| {
+                                        InputError(format!(
+                                            "radiation.area_m2.{dof} = {a}: expected a number (m²)"
+                                        ))
+                                    })?;
+                                    s.apply_in("radiation", &format!("area_m2.{dof}"), &setting)?;
+                                }
+                            }
+                            ("area_m2", v) => {
+                                return err(format!(
+                                    "radiation.area_m2 = {v}: expected a table [radiation.area_m2] of dof = area (m²)"
+                                ))
+                            }
+                            (k, v) => {
+                                let setting = Setting::from_toml(v).ok_or_else(|| {
+                                    InputError(format!("radiation.{k} = {v}: unexpected value"))
+                                })?;
+                                s.apply_in("radiation", k, &setting)?;
+                            }
+                        }
+                    }
+                }
+                ("radiation", v) => {
+                    return err(format!("radiation = {v}: expected a table [radiation]"))
                 }
                 ("friction", _) if lumped => {
                     return err(format!(
@@ -466,6 +501,7 @@ impl Scenario {
             "rtol" | "atol_pos" | "atol_vel" | "h_max" => "solver",
             k if self.atol_index(k).is_some() => "solver",
             k if self.offset_index(k).is_some() => "offsets",
+            k if k.starts_with("radiation.") => "radiation",
             k if self.model.get(k).is_some() => "params",
             "model" => {
                 return err("model cannot be changed by --set: choose a scenario of that model")
@@ -516,11 +552,18 @@ impl Scenario {
         if matches!(self.model, AnyModel::DiscPad(_)) {
             keys.push("contact".into());
         }
+        keys.extend(Radiation::known_keys(&self.positions()));
         for n in self.model.state_names() {
             keys.push(format!("{n}0"));
             keys.push(format!("atol_{n}"));
         }
         keys
+    }
+
+    /// The model's position coordinates (its dofs), the first half of its state.
+    pub fn positions(&self) -> Vec<String> {
+        let names = self.model.state_names();
+        names[..names.len() / 2].to_vec()
     }
 
     /// `atol_<state>`: a per-state absolute tolerance.
@@ -643,6 +686,15 @@ impl Scenario {
                     return err(format!("h_max = {x}: must be > 0 (s)"));
                 }
                 self.solver.h_max = x;
+            }
+            ("radiation", k) => {
+                let k = k.strip_prefix("radiation.").unwrap_or(k);
+                let v = match value {
+                    Setting::Number(x) => format!("{x:?}"),
+                    Setting::Text(t) => t.clone(),
+                };
+                let positions = self.positions();
+                self.radiation.set(k, &v, &positions).map_err(InputError)?;
             }
             ("offsets", k) => {
                 let i = self.offset_index(k).ok_or_else(|| {
@@ -769,6 +821,7 @@ impl Scenario {
         if let AnyModel::DiscPad(m) = &self.model {
             out["contact"] = json!(m.contact.as_str());
         }
+        out["radiation"] = self.radiation.to_json();
         if let AnyModel::Lumped(l) = &self.model {
             // Keys bound to expressions of [params]: each with its value.
             let b = l.shared().bindings();
@@ -858,6 +911,7 @@ impl Scenario {
         if let AnyModel::Lumped(l) = &self.model {
             let _ = writeln!(t, "{}", crate::lumped_file::to_toml(l, &self.matrices));
             self.write_offsets_solver(&mut t);
+            t.push_str(&self.radiation.to_toml(&Radiation::default_for(&self.model)));
             return t;
         }
         let _ = writeln!(t, "\n[params]");
@@ -885,6 +939,7 @@ impl Scenario {
             );
         }
         self.write_offsets_solver(&mut t);
+        t.push_str(&self.radiation.to_toml(&Radiation::default_for(&self.model)));
         t
     }
 

@@ -11,6 +11,7 @@ mod fe_files_cli;
 mod levers_cli;
 mod lumped_cli;
 mod params_cli;
+mod radiation_cli;
 mod reliability;
 mod reliability_inputs;
 mod reliability_limits;

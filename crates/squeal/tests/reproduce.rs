@@ -166,6 +166,10 @@ fn reproduce_writes_the_table_the_conclusions_and_the_report() {
     let f: f64 = r15["squeal_frequency_hz"].parse().unwrap();
     assert!((f - 20_751.0).abs() <= 0.005 * 20_751.0, "{f}");
     assert!(r15["squeal_level_db"].parse::<f64>().is_ok());
+    // How loud: the disc faces (y_d) radiate; a squealing set is loud.
+    let erp: f64 = r15["erp_db"].parse().unwrap();
+    let dba: f64 = r15["spl_dba"].parse().unwrap();
+    assert!(erp > 60.0 && dba > 40.0 && dba < erp, "{erp} {dba}");
     assert!(
         md.contains("Sets that squeal: ") && md.contains("15 (x_p 2075"),
         "squeal in the report"

@@ -136,7 +136,7 @@ fn transient_map_classifies_by_simulation() {
     let csv = std::fs::read_to_string(d.path().join("t/map.csv")).unwrap();
     assert_eq!(
         csv.lines().next().unwrap(),
-        "V,c,max_growth_rate,freq_hz,outcome,rms_tangential,stick_fraction,t_end,agree"
+        "V,c,max_growth_rate,freq_hz,outcome,rms_tangential,stick_fraction,t_end,agree,spl_dba"
     );
     for line in csv.lines().skip(1) {
         let f: Vec<&str> = line.split(',').collect();

@@ -107,7 +107,7 @@ pub fn write_rows(
     let f = |v: f64| if exact { format!("{v:e}") } else { num(v) };
     let mut header = format!("{},{},max_growth_rate,freq_hz", x.name, y.name);
     if trans.is_some() {
-        header.push_str(",outcome,rms_tangential,stick_fraction,t_end,agree");
+        header.push_str(",outcome,rms_tangential,stick_fraction,t_end,agree,spl_dba");
     }
     if exact {
         header.insert_str(0, "index,");
@@ -130,12 +130,13 @@ pub fn write_rows(
             let o = &t[r];
             write!(
                 w,
-                ",{},{},{},{},{}",
+                ",{},{},{},{},{},{}",
                 o.class,
                 f(o.rms),
                 f(o.stick_fraction),
                 f(o.t_end),
-                agree(*s, o)
+                agree(*s, o),
+                f(o.spl_dba)
             )?;
         }
         writeln!(w)?;
@@ -217,6 +218,36 @@ pub fn write_map(
         &spec,
     )
     .map_err(plot_err)?;
+    // How loud each point is, where the scenario names radiating surfaces.
+    let dba: Vec<f64> = t.iter().map(|o| o.spl_dba).collect();
+    if dba.iter().any(|v| v.is_finite()) {
+        let title = format!(
+            "{}: A-weighted sound pressure level of each run's last window",
+            labels.name
+        );
+        let spec = HeatmapSpec {
+            log_x: x.log,
+            log_y: y.log,
+            colormap: Colormap::Sequential,
+            nan_label: "silent or failed",
+            ..HeatmapSpec::new(
+                &title,
+                xl,
+                yl,
+                "SPL (dB(A) re 20 µPa)",
+                &x.values,
+                &y.values,
+                &dba,
+            )
+        };
+        squeal_plot::heatmap(
+            stage.path("spl_dba"),
+            &[Format::Png, Format::Svg],
+            squeal_plot::SIZE_SINGLE,
+            &spec,
+        )
+        .map_err(plot_err)?;
+    }
     Ok(t.iter()
         .zip(lin)
         .filter(|(o, (s, _))| agree(*s, o) == "no")
@@ -259,10 +290,10 @@ pub fn report(
     crate::outln!(
         "output: {} (map.csv, map.png{})",
         dest.display(),
-        if disagree.is_some() {
-            ", transient.png"
-        } else {
-            ""
+        match disagree {
+            Some(_) if dest.join("spl_dba.png").exists() => ", transient.png, spl_dba.png",
+            Some(_) => ", transient.png",
+            None => "",
         }
     );
     Ok(())

@@ -469,6 +469,8 @@ fn read_part(
                 rms,
                 stick_fraction: stick,
                 t_end,
+                // Shards written before the column existed have none.
+                spl_dba: num(10).unwrap_or(f64::NAN),
             };
         }
         count += 1;

@@ -82,7 +82,7 @@ fn opt(x: Option<f64>, prec: usize) -> String {
 /// The parameters the table shows for every set (the ones the sets vary).
 const TABLE_PARAMS: [&str; 8] = ["V", "N", "f1", "alpha", "c_dx", "c_dy", "c_px", "c_py"];
 
-const TABLE_HEADER: &str = "set,question,V,N,f1,alpha,c_dx,c_dy,c_px,c_py,duration,linear,max_growth_rate,least_stable_hz,verdict,tangential_hz,normal_hz,growth_rate_vx_p,growth_rate_vx_d,stick_fraction,reversals,sticks,tangential_zero,agree,squeal_coordinate,squeal_frequency_hz,squeal_level_db,separations,valid";
+const TABLE_HEADER: &str = "set,question,V,N,f1,alpha,c_dx,c_dy,c_px,c_py,duration,linear,max_growth_rate,least_stable_hz,verdict,tangential_hz,normal_hz,growth_rate_vx_p,growth_rate_vx_d,stick_fraction,reversals,sticks,tangential_zero,agree,squeal_coordinate,squeal_frequency_hz,squeal_level_db,separations,valid,erp_db,spl_dba";
 
 fn table_csv(rs: &[SetResult]) -> String {
     let mut t = String::from(TABLE_HEADER);
@@ -92,7 +92,7 @@ fn table_csv(rs: &[SetResult]) -> String {
         let params: Vec<String> = TABLE_PARAMS.iter().map(|k| r.p(k).to_string()).collect();
         let _ = writeln!(
             t,
-            "{},\"{}\",{},{},{},{},{},{},{},{},{},{},{:e},{},{},{},{},{},{},{},{},{}",
+            "{},\"{}\",{},{},{},{},{},{},{},{},{},{},{:e},{},{},{},{},{},{},{},{},{},{},{}",
             r.id,
             q,
             params.join(","),
@@ -119,6 +119,8 @@ fn table_csv(rs: &[SetResult]) -> String {
             opt(r.squeal.as_ref().map(|s| s.level_db), 2),
             r.events[EventKind::Separate.index()],
             r.outside().is_none(),
+            opt(r.erp_db, 2),
+            opt(r.spl_dba, 2),
         );
     }
     t

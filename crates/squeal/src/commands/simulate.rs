@@ -187,6 +187,15 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         if let Some(g) = answer.growth_line() {
             crate::outln!("{g}");
         }
+        crate::outln!("{}", squeal_study::radiation::sound_line(&answer.sound));
+        if let Some(note) = answer
+            .sound
+            .as_ref()
+            .ok()
+            .and_then(|s| s.squeal_note(answer.squeal.as_ref().map(|q| q.coordinate.as_str())))
+        {
+            crate::outln!("  note: {note}");
+        }
         print_human(&sc, &run, &summary, &dest);
     }
     if let Some(note) = hearing {
