@@ -263,8 +263,10 @@ def map(
 
     An ``xarray.Dataset`` with coordinates named after the parameters and
     variables ``max_growth_rate`` (1/s, NaN where steady sliding does not
-    exist) and ``freq_hz``, plus ``outcome``, ``rms_tangential``,
-    ``stick_fraction``, ``t_end`` and ``agree`` with ``transient=True``;
+    exist) and ``freq_hz``, plus ``outcome``, ``rms_tangential`` (m/s),
+    ``stick_fraction``, ``t_end`` (s), ``agree`` and ``spl_dba`` (dB(A) re
+    20 µPa at the scenario's ``radiation.distance_m``, NaN without radiating
+    surfaces) with ``transient=True``;
     without xarray a dict of the same names (2-D arrays, y × x, and the two
     coordinate arrays)."""
     raw = _squeal.stability_map(
@@ -273,7 +275,7 @@ def map(
     )
     xn, yn = raw["x_name"], raw["y_name"]
     shape = (len(raw["y"]), len(raw["x"]))
-    names = ["max_growth_rate", "freq_hz", "outcome", "rms_tangential", "stick_fraction", "t_end", "agree"]
+    names = ["max_growth_rate", "freq_hz", "outcome", "rms_tangential", "stick_fraction", "t_end", "agree", "spl_dba"]
     grids = {k: np.asarray(raw[k]).reshape(shape) for k in names if k in raw}
     try:
         import xarray as xr
@@ -287,6 +289,8 @@ def map(
     ds[yn].attrs["units"] = raw["y_unit"]
     ds["max_growth_rate"].attrs["units"] = "1/s"
     ds["freq_hz"].attrs["units"] = "Hz"
+    if "spl_dba" in ds:
+        ds["spl_dba"].attrs["units"] = "dB(A) re 20 µPa"
     return ds
 
 

@@ -406,6 +406,13 @@ fn stability_map<'py>(
                 .into_pyarray(py),
         )?;
         out.set_item(
+            "spl_dba",
+            t.iter()
+                .map(|o| o.spl_dba)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )?;
+        out.set_item(
             "agree",
             t.iter()
                 .zip(&lin)

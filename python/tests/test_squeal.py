@@ -140,6 +140,9 @@ def test_transient_map_point_outcomes():
     m = squeal.map(x=("V", 1, 10, 2), y=("N", 500, 2000, 2), transient=True, duration=0.05)
     assert np.asarray(m["outcome"]).shape == (2, 2)
     assert np.asarray(m["agree"]).shape == (2, 2)
+    # The disc faces radiate: every squealing point has a level (dB(A)).
+    dba = np.asarray(m["spl_dba"])
+    assert dba.shape == (2, 2) and np.all(np.isfinite(dba)) and np.all(dba > 60.0)
 
 
 def test_critical_equals_cli_json(cli):
