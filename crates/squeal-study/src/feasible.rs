@@ -259,16 +259,23 @@ pub fn series_bytes(sc: &Scenario) -> f64 {
     rows * cols * 8.0
 }
 
-/// Check that `sc` can be run, before any work: the series fits in memory,
+/// Check that `sc` can be run, before any work: the model is one squeal
+/// can simulate, the series fits in memory,
 /// the sample rate resolves the fastest mode, and the integration needs a
 /// bounded number of steps; then set the run's step budget
-/// (`sc.solver.max_steps`). `what` names the run in messages.
+/// (`sc.solver.max_steps`). Every input limit the request breaks is named
+/// in one refusal.
 pub fn prepare(sc: &mut Scenario) -> Result<(), StudyError> {
     sc.validate()?;
+    // Every limit the request breaks, named in one refusal (not one per attempt).
+    let mut broken: Vec<String> = Vec::new();
+    if let Err(e) = sc.model.check_simulable() {
+        broken.push(e);
+    }
     let bytes = series_bytes(sc);
     if bytes > MAX_SERIES_BYTES {
         let (rows, cols) = series_shape(sc);
-        return Err(InputError(format!(
+        broken.push(format!(
             "sample_rate = {}: {} s at {} Hz is {rows:.3e} samples × {cols} columns = {:.2} GB in memory \
              (limit {:.2} GB); lower sample_rate or duration",
             sc.sample_rate,
@@ -276,34 +283,50 @@ pub fn prepare(sc: &mut Scenario) -> Result<(), StudyError> {
             sc.sample_rate,
             bytes / 1e9,
             MAX_SERIES_BYTES / 1e9
-        ))
-        .into());
-    }
-    let need = RUN_MEMORY_PER_SERIES_BYTE * bytes;
-    if need > MEMORY_CHECK_FROM {
-        crate::memory::check(
-            need,
-            &format!(
-                "sample_rate = {}: {} s at {} Hz ({:.2} GB of series, written as CSV and analysed)",
-                sc.sample_rate,
-                sc.duration,
-                sc.sample_rate,
-                bytes / 1e9
-            ),
-        )
-        .map_err(|m| InputError(format!("{m}; lower sample_rate or duration")))?;
+        ));
+    } else {
+        let need = RUN_MEMORY_PER_SERIES_BYTE * bytes;
+        if need > MEMORY_CHECK_FROM {
+            if let Err(m) = crate::memory::check(
+                need,
+                &format!(
+                    "sample_rate = {}: {} s at {} Hz ({:.2} GB of series, written as CSV and analysed)",
+                    sc.sample_rate,
+                    sc.duration,
+                    sc.sample_rate,
+                    bytes / 1e9
+                ),
+            ) {
+                broken.push(format!("{m}; lower sample_rate or duration"));
+            }
+        }
     }
     let scales = scales(&sc.model, Some(sc)).map_err(|e| stability_failure(&sc.model, e))?;
     let lambda = scales.as_ref().map_or(0.0, |s| s.lambda_max);
     if let Some(s) = &scales {
         let least = 2.0 * s.f_max_hz;
         if sc.sample_rate < least {
-            return Err(InputError(format!(
+            broken.push(format!(
                 "sample_rate = {}: below twice the fastest mode ({:.6e} Hz): the series would alias it; \
                  the least rate that works is {least:.6e} Hz",
                 sc.sample_rate, s.f_max_hz
+            ));
+        }
+    }
+    match broken.len() {
+        0 => {}
+        1 => return Err(InputError(broken.remove(0)).into()),
+        n => {
+            return Err(InputError(format!(
+                "{n} limits broken: {}",
+                broken
+                    .iter()
+                    .enumerate()
+                    .map(|(i, b)| format!("({}) {b}", i + 1))
+                    .collect::<Vec<_>>()
+                    .join("; ")
             ))
-            .into());
+            .into())
         }
     }
     // An h_max below the integrator's least step (16 ε · 1e-6 s at t = 0)
