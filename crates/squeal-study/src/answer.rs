@@ -35,6 +35,7 @@
 
 use nalgebra::Complex;
 use serde_json::{json, Map, Value};
+use squeal_core::stability::is_growing;
 use squeal_core::stability::sensitivity::Eigenvectors;
 use squeal_signal::{LineSpectrum, RunVerdict, DB_PER_NEPER};
 
@@ -81,10 +82,20 @@ impl Linear {
     pub fn freq_hz(&self) -> f64 {
         self.lambda.im / std::f64::consts::TAU
     }
+    /// Whether the prediction grows: `σ > 0` beyond the eigen-solver's
+    /// round-off ([`is_growing`]; an undamped mode's `σ = 1e-11` is neutral).
+    pub fn grows(&self) -> bool {
+        is_growing(self.lambda.re, self.lambda.im)
+    }
     /// The frequencies (Hz) of every growing eigenvalue (each conjugate
-    /// pair once), most unstable first.
+    /// pair once, round-off excluded), most unstable first.
     pub fn growing_hz(&self) -> Vec<f64> {
-        let mut g: Vec<Complex<f64>> = self.all.iter().copied().filter(|e| e.re > 0.0).collect();
+        let mut g: Vec<Complex<f64>> = self
+            .all
+            .iter()
+            .copied()
+            .filter(|e| is_growing(e.re, e.im))
+            .collect();
         g.sort_by(|a, b| b.re.total_cmp(&a.re));
         g.iter().map(|e| e.im / std::f64::consts::TAU).collect()
     }
@@ -607,7 +618,7 @@ fn still_linear(
     growth: Option<&ModalGrowth>,
     to_end: bool,
 ) -> Option<(RunVerdict, String)> {
-    let l = lin.filter(|l| l.growth_rate() > 0.0)?;
+    let l = lin.filter(|l| l.grows())?;
     let g = growth?;
     let (rate, (t0, t1)) = (g.rate?, g.window?);
     let j = &an.judgement;
@@ -666,7 +677,7 @@ fn squeal_answer(
         verdict,
         RunVerdict::LimitCycle | RunVerdict::StickSlip | RunVerdict::LiftOff
     );
-    let unstable = lin.filter(|l| l.growth_rate() > 0.0);
+    let unstable = lin.filter(|l| l.grows());
     if let Some(s) = &j.squeal {
         // The strongest line; for a strictly periodic stick–slip cycle
         // with one stick a period (the stick frequency within the line's

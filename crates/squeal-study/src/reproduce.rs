@@ -178,13 +178,20 @@ pub fn linear_of(model: &AnyModel) -> Result<Linear, String> {
     })
 }
 
-/// The squeal of a run, as the analysis answers it.
-pub fn squeal_answer(an: &Analysis) -> Option<SquealAnswer> {
-    an.judgement.squeal.as_ref().map(|s| SquealAnswer {
-        coordinate: s.coordinate.clone(),
-        frequency_hz: s.frequency_hz,
-        level_db: s.level_db,
-    })
+/// The squeal a run shows, as its [`Answer`](crate::answer::Answer) gives
+/// it (the number `simulate` prints and writes): `None` when nothing
+/// squeals, or the run ended before the squeal was established (the
+/// answer is then a linear prediction, not something the run shows).
+pub fn squeal_answer(answer: &crate::answer::Answer) -> Option<SquealAnswer> {
+    answer
+        .squeal
+        .as_ref()
+        .filter(|s| s.source == crate::answer::Source::Run)
+        .map(|s| SquealAnswer {
+            coordinate: s.coordinate.clone(),
+            frequency_hz: s.frequency_hz,
+            level_db: s.level_db.unwrap_or(f64::NAN),
+        })
 }
 
 /// Measure one set: its eigenvalues, a run and its analysis, and the
@@ -223,6 +230,8 @@ pub fn measure_run<E: From<StudyError>>(
         &[],
     );
     after(&run, &an)?;
+    // One answer: the verdict and squeal `simulate` gives for this run.
+    let answer = crate::answer::Answer::of(&sc, &run, &an);
     let col = |n: &str| run.column(n).unwrap_or(&[]);
     let vxd = col("vx_d");
     let n = vxd.len();
@@ -278,7 +287,7 @@ pub fn measure_run<E: From<StudyError>>(
         study::envelope_rate(&b, 0.0, sc.duration)
     });
     let total: f64 = stats.mode_time.iter().sum();
-    let sound = crate::radiation::Sound::of(&sc.radiation, &run, an.judgement.window).ok();
+    let sound = answer.sound.as_ref().ok();
     let finite = |x: f64| x.is_finite().then_some(x);
     Ok(SetResult {
         erp_db: sound.as_ref().and_then(|s| finite(s.levels.erp_db)),
@@ -286,7 +295,7 @@ pub fn measure_run<E: From<StudyError>>(
         id,
         linear,
         linear_note,
-        verdict: an.verdict.as_str().to_string(),
+        verdict: answer.verdict(&an).as_str().to_string(),
         f_t,
         f_n,
         growth: an.growth.iter().map(|g| (g.0.clone(), g.1)).collect(),
@@ -309,7 +318,7 @@ pub fn measure_run<E: From<StudyError>>(
         } else {
             0.0
         },
-        squeal: squeal_answer(&an),
+        squeal: squeal_answer(&answer),
         normal_power,
         normal_rate,
         sc,
