@@ -203,3 +203,17 @@ fn a_run_ended_before_the_squeal_shows_gives_the_linear_prediction_and_says_so()
     let g = &v["linear"]["measured_growth"];
     assert!(g["rate"].is_null() && g["reason"].is_string(), "{g}");
 }
+
+/// An undamped set with constant friction (thesis set 6) has a leading
+/// eigenvalue whose σ = +1.2e-11 1/s is the eigen-solver's round-off of 0
+/// (|σ| ≤ 1e-12·|λ|): the answer calls it neutral, names no growing mode
+/// and no squeal, instead of "too short" with an e-fold time of 8e10 s.
+#[test]
+fn a_round_off_sigma_is_neutral_not_growing() {
+    let v = run("thesis-06", "0.1", &[]);
+    let sigma = f(&v["linear"]["growth_rate"]);
+    assert!(sigma.abs() < 1e-9, "{sigma}");
+    assert_eq!(v["linear"]["growing_modes"], 0);
+    assert_eq!(v["verdict"], "neutral");
+    assert!(v["squeal"].is_null(), "{}", v["squeal"]);
+}
