@@ -225,3 +225,155 @@ pub fn verdict_word(an: &Analysis) -> &'static str {
         "unstable"
     }
 }
+
+/// Two bases agree when the tracked eigenvalues differ by at most this
+/// fraction of their modulus (issue 27 §2: "below 1e-3 relative").
+pub const SETTLED: f64 = 1e-3;
+
+/// How a projected analysis's eigenvalues move as its basis grows
+/// ([`squeal_core::stability::projected::truncation_table`]): the
+/// truncation error made visible.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Convergence {
+    /// The rows, smallest basis first (the last is the analysis's own).
+    pub rows: Vec<squeal_core::stability::projected::Truncation>,
+    /// The eigenvalues followed: every growing one of the analysis (`ω ≥ 0`),
+    /// or the least stable one when none grows.
+    pub tracked: Vec<nalgebra::Complex<f64>>,
+    /// Per row, the eigenvalue nearest to each tracked one.
+    pub matched: Vec<Vec<nalgebra::Complex<f64>>>,
+    /// Per tracked eigenvalue, `|λ_last − λ_previous| / |λ_last|` between
+    /// the last two rows (0 with one row).
+    pub change: Vec<f64>,
+    /// Every change is at most [`SETTLED`] and no tracked growth rate
+    /// changes sign between the last two rows.
+    pub settled: bool,
+}
+
+/// The truncation table of a model analysed by projection, following the
+/// eigenvalues of `an` (its analysis); `None` for a model solved dense.
+pub fn convergence(model: &AnyModel, an: &Analysis) -> Option<Result<Convergence, StabilityError>> {
+    let AnyModel::Lumped(l) = model else {
+        return None;
+    };
+    let rows = match squeal_core::stability::lumped::truncation_table(l)? {
+        Ok(r) => r,
+        Err(e) => return Some(Err(e)),
+    };
+    let mut tracked: Vec<nalgebra::Complex<f64>> = an
+        .eigen
+        .iter()
+        .filter(|e| e.growing && e.im >= 0.0)
+        .map(|e| nalgebra::Complex::new(e.re, e.im))
+        .collect();
+    if tracked.is_empty() {
+        let e = an.least_stable_mode();
+        tracked.push(nalgebra::Complex::new(e.re, e.im.abs()));
+    }
+    let matched: Vec<Vec<nalgebra::Complex<f64>>> = rows
+        .iter()
+        .map(|r| {
+            tracked
+                .iter()
+                .map(|t| {
+                    r.eigenvalues
+                        .iter()
+                        .copied()
+                        .min_by(|a, b| (a - t).norm().total_cmp(&(b - t).norm()))
+                        .unwrap_or(nalgebra::Complex::new(f64::NAN, f64::NAN))
+                })
+                .collect()
+        })
+        .collect();
+    let k = matched.len();
+    let change: Vec<f64> = (0..tracked.len())
+        .map(|j| {
+            if k < 2 {
+                return 0.0;
+            }
+            let (last, prev) = (matched[k - 1][j], matched[k - 2][j]);
+            (last - prev).norm() / last.norm()
+        })
+        .collect();
+    let signs_kept = k < 2
+        || (0..tracked.len()).all(|j| (matched[k - 1][j].re > 0.0) == (matched[k - 2][j].re > 0.0));
+    let settled = signs_kept && change.iter().all(|c| *c <= SETTLED);
+    Some(Ok(Convergence {
+        rows,
+        tracked,
+        matched,
+        change,
+        settled,
+    }))
+}
+
+impl Convergence {
+    /// The warning when the tracked eigenvalues have not settled.
+    pub fn warning(&self) -> Option<String> {
+        (!self.settled).then(|| {
+            let worst = self.change.iter().copied().fold(0.0f64, f64::max);
+            let last = self.rows.last().map_or(0.0, |r| r.basis_max_hz);
+            format!(
+                "the eigenvalues have not settled with the basis: they still move by {worst:.1e} of their modulus (or a growth rate changes sign) between the last two bases; add modes (modal.cutoff_hz above {last:.0} Hz, or modal.modes)"
+            )
+        })
+    }
+
+    /// `stability --json`'s `convergence`: `rows` (`modes`, `basis_max_hz`,
+    /// `static_vectors`, `eigenvalues`: the tracked ones as `{re, im,
+    /// freq_hz}`), `relative_change`, `tolerance`, `settled`, `warning`.
+    pub fn to_json(&self) -> Value {
+        json!({
+            "rows": self.rows.iter().zip(&self.matched).map(|(r, m)| json!({
+                "modes": r.modes,
+                "basis_max_hz": r.basis_max_hz,
+                "static_vectors": r.static_vectors,
+                "eigenvalues": m.iter().map(|e| json!({
+                    "re": e.re, "im": e.im, "freq_hz": e.im / std::f64::consts::TAU,
+                })).collect::<Vec<_>>(),
+            })).collect::<Vec<_>>(),
+            "relative_change": self.change,
+            "tolerance": SETTLED,
+            "settled": self.settled,
+            "warning": self.warning(),
+        })
+    }
+
+    /// The table for the terminal: one line per basis, the tracked
+    /// eigenvalues as `σ (1/s) @ f (Hz)`.
+    pub fn table_lines(&self) -> Vec<String> {
+        let mut out = vec![format!(
+            "truncation (the {} eigenvalue{} as the basis grows; settled when the last two agree to {SETTLED:.0e} of |λ|):",
+            if self.tracked.iter().any(|t| t.re > 0.0) { "growing" } else { "least stable" },
+            if self.tracked.len() == 1 { "" } else { "s" }
+        )];
+        out.push(format!(
+            "{:>7}  {:>12}  {:>6}  eigenvalues σ (1/s) @ f (Hz)",
+            "modes", "up to (Hz)", "static"
+        ));
+        for (r, m) in self.rows.iter().zip(&self.matched) {
+            let ev: Vec<String> = m
+                .iter()
+                .map(|e| format!("{:+.6e} @ {:.3}", e.re, e.im / std::f64::consts::TAU))
+                .collect();
+            out.push(format!(
+                "{:>7}  {:>12.1}  {:>6}  {}",
+                r.modes,
+                r.basis_max_hz,
+                r.static_vectors,
+                ev.join(", ")
+            ));
+        }
+        let change: Vec<String> = self.change.iter().map(|c| format!("{c:.1e}")).collect();
+        out.push(format!(
+            "last change: {} of |λ|: {}",
+            change.join(", "),
+            if self.settled {
+                "settled"
+            } else {
+                "NOT settled"
+            }
+        ));
+        out
+    }
+}

@@ -349,3 +349,84 @@ fn every_broken_limit_is_named_in_one_refusal() {
     );
     assert!(!d.path().join("o").exists());
 }
+
+/// The truncation error made visible (issue 27 §2): `stability` of a
+/// projected FE brake prints the growing eigenvalue for growing bases
+/// (`convergence` in the JSON). Against the dense eigenvalue of the same
+/// 124-dof model, the error does not grow with the basis, is below 1e-3
+/// (relative) once the modes reach twice the squeal frequency, and the last
+/// row is the analysis's own eigenvalue. A basis that stops below the
+/// squeal's modes is flagged: not settled, with a warning.
+#[test]
+fn the_projected_eigenvalue_converges_as_the_basis_grows() {
+    let d = tempfile::tempdir().unwrap();
+    let brake = example("two-pad").join("brake.toml");
+    let brake = brake.to_str().unwrap();
+    let dense = json(&squeal(
+        d.path(),
+        &["stability", brake, "--json", "--no-levers"],
+    ));
+    assert!(
+        dense.get("convergence").is_none(),
+        "a dense analysis truncates nothing"
+    );
+    let exact = (
+        f(&dense["least_stable"]["re"]),
+        f(&dense["least_stable"]["im"]),
+    );
+    let f_squeal = exact.1 / std::f64::consts::TAU;
+    let run = |modes: &str| {
+        squeal(
+            d.path(),
+            &[
+                "stability",
+                brake,
+                "--json",
+                "--no-levers",
+                "--set",
+                "modal.dense_max_dofs=0",
+                "--set",
+                &format!("modal.modes={modes}"),
+            ],
+        )
+    };
+    let out = run("16");
+    let v = json(&out);
+    let c = &v["convergence"];
+    let rows = c["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 4);
+    let err = |r: &serde_json::Value| {
+        let e = &r["eigenvalues"][0];
+        (f(&e["re"]) - exact.0).hypot(f(&e["im"]) - exact.1) / exact.0.hypot(exact.1)
+    };
+    let errors: Vec<f64> = rows.iter().map(err).collect();
+    for w in errors.windows(2) {
+        assert!(w[1] <= w[0] * 1.01 + 1e-12, "the error grew: {errors:?}");
+    }
+    let mut checked = 0;
+    for (r, e) in rows.iter().zip(&errors) {
+        if f(&r["basis_max_hz"]) >= 2.0 * f_squeal {
+            assert!(*e < 1e-3, "modes to {} Hz: error {e}", r["basis_max_hz"]);
+            checked += 1;
+        }
+    }
+    assert!(checked >= 2, "{errors:?}");
+    assert!(
+        errors[0] > 1e-2,
+        "the smallest basis is far off: {errors:?}"
+    );
+    let last = &rows[3]["eigenvalues"][0];
+    assert!((f(&last["re"]) - f(&v["least_stable"]["re"])).abs() < 1e-9 * exact.1);
+    assert_eq!(c["settled"], true);
+    assert!(c["warning"].is_null());
+    // Four modes reach 563 Hz, below the 696 Hz squeal: not settled.
+    let out = run("4");
+    let v = json(&out);
+    assert_eq!(v["convergence"]["settled"], false);
+    let err_text = String::from_utf8_lossy(&out.stderr);
+    assert!(err_text.contains("have not settled"), "{err_text}");
+}
+
+fn f(v: &serde_json::Value) -> f64 {
+    v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
+}

@@ -69,6 +69,16 @@ pub fn max_growth_rate(l: &Lumped) -> Result<(f64, f64), StabilityError> {
     Ok((best.re, best.im.abs() / (2.0 * std::f64::consts::PI)))
 }
 
+/// The truncation table of a model analysed by projection
+/// ([`projected::truncation_table`] with its `modal.*` basis); `None` for a
+/// model solved dense (nothing is truncated).
+pub fn truncation_table(l: &Lumped) -> Option<Result<Vec<projected::Truncation>, StabilityError>> {
+    l.modal.projects(l.dof_count()).then(|| {
+        let z = equilibrium(l)?;
+        projected::truncation_table(&l.second_order_dyn(&z), l.modal.basis())
+    })
+}
+
 /// Full complex eigenvalue analysis of a lumped model of any size (every
 /// mode with its eigenvector, energy shares and dominant coordinate): dense
 /// by [`super::modal::analyse_matrix`] up to `l.modal.dense_max_dofs` dofs,

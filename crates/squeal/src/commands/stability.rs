@@ -100,8 +100,23 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         let bar = crate::run::progress_bar(lever_keys(&sc.model).len() as u64, "searching levers");
         squeal_study::levers::search(&sc.model, &bar, &crate::run::NEVER)?
     };
+    // The truncation error of a projected analysis (issue 27 §2).
+    let convergence = match squeal_study::stability::convergence(&sc.model, &an) {
+        Some(Ok(c)) => Some(c),
+        Some(Err(e)) => {
+            crate::errln!("warning: no truncation table: {e}");
+            None
+        }
+        None => None,
+    };
+    if let Some(w) = convergence.as_ref().and_then(|c| c.warning()) {
+        crate::errln!("warning: {w}");
+    }
     if a.json {
-        let doc = document(&sc, &an, &levers);
+        let mut doc = document(&sc, &an, &levers);
+        if let Some(c) = &convergence {
+            doc["convergence"] = c.to_json();
+        }
         crate::outln!(
             "{}",
             serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
@@ -122,6 +137,9 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         an.max_growth_rate
     );
     if let Some(line) = modal_line(&an) {
+        crate::outln!("{line}");
+    }
+    for line in convergence.iter().flat_map(|c| c.table_lines()) {
         crate::outln!("{line}");
     }
     crate::outln!(
