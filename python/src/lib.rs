@@ -178,7 +178,9 @@ fn simulate<'py>(
     sets: Vec<String>,
     duration: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let sc = with_source(kind, text, |s| scenario::resolve_run(s, &sets, duration))?;
+    let sc = with_source(kind, text, |s| {
+        squeal_study::feasible::resolve_run(s, &sets, duration)
+    })?;
     let (run, summary, spectra) = compute(py, |cancel| {
         let start = std::time::Instant::now();
         let mut run = squeal_study::run::run(&sc, &NoProgress, cancel)?;
@@ -190,7 +192,7 @@ fn simulate<'py>(
             sc.validity,
             &[],
         );
-        let mut summary = squeal_study::analysis::summary_json(&sc, &run, &an);
+        let mut summary = squeal_study::answer::summary_json(&sc, &run, &an);
         summary["timing"] = serde_json::json!({ "integrate_s": run.integrate_s });
         let spectra: Vec<(String, Vec<f64>, Vec<f64>)> = an
             .spectra
@@ -330,7 +332,9 @@ fn stability_map<'py>(
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let sc = if transient || duration.is_some() {
-        with_source(kind, text, |s| scenario::resolve_run(s, &sets, duration))?
+        with_source(kind, text, |s| {
+            squeal_study::feasible::resolve_run(s, &sets, duration)
+        })?
     } else {
         resolve(kind, text, &sets)?
     };

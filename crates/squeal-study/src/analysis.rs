@@ -3,10 +3,9 @@
 //! verdict (`squeal_signal::judge`), and their JSON for `summary.json`.
 //! The pictures and sound made from them are the CLI's.
 
+use crate::error::InputError;
 use crate::model::Channels;
 use crate::run::Run;
-use crate::scenario::InputError;
-use crate::scenario::Scenario;
 use serde_json::{json, Map, Value};
 use squeal_core::EventKind;
 use squeal_signal::spectrum::Scaling;
@@ -561,43 +560,4 @@ pub fn integrator_json(run: &Run) -> Value {
         "stick_fraction": s.stick_fraction(),
         "t_final": run.info.t_final,
     })
-}
-
-/// The document `summary.json` holds for a run of `sc` analysed as `an`:
-/// the integration (`integrator`, `events`, `stick_fraction`, `t_final`),
-/// `scenario`, `columns`, the tail `rms` of every velocity, `spectrum`,
-/// `growth_rate`, `verdict`, `verdict_detail`, `squeal` and `linear` (the
-/// [`Answer`](crate::answer::Answer) of the run), and `radiation` (its
-/// sound over the judged window, [`crate::radiation`]). The CLI adds `audio` and
-/// `timing`.
-pub fn summary_json(sc: &Scenario, run: &Run, an: &Analysis) -> Value {
-    summary_json_with(sc, run, an, &crate::answer::Answer::of(sc, run, an))
-}
-
-/// [`summary_json`] with the run's answer already computed.
-pub fn summary_json_with(
-    sc: &Scenario,
-    run: &Run,
-    an: &Analysis,
-    answer: &crate::answer::Answer,
-) -> Value {
-    let velocity_names: Vec<String> = {
-        let names = sc.model.state_names();
-        names[names.len() / 2..].to_vec()
-    };
-    let mut summary = integrator_json(run);
-    summary["scenario"] = sc.to_json();
-    summary["columns"] = json!(run.columns);
-    summary["rms"] = json!(tail_rms(run, &velocity_names));
-    summary["spectrum"] = an.spectrum_json();
-    summary["growth_rate"] = answer.growth_rate_json(an);
-    summary["verdict"] = json!(answer.verdict(an).as_str());
-    summary["verdict_detail"] = answer.verdict_detail_json(an);
-    summary["squeal"] = answer.squeal_json();
-    summary["linear"] = answer.linear_json();
-    summary["radiation"] = crate::radiation::radiation_json(
-        &answer.sound,
-        answer.squeal.as_ref().map(|s| s.coordinate.as_str()),
-    );
-    summary
 }

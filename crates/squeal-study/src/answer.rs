@@ -41,9 +41,9 @@ use squeal_signal::{LineSpectrum, RunVerdict, DB_PER_NEPER};
 
 use crate::analysis::{si, state_pairs, Analysis};
 use crate::model::AnyModel;
-use crate::radiation::Sound;
 use crate::run::Run;
 use crate::scenario::Scenario;
+use crate::sound::Sound;
 
 /// Eighths of a linear stretch must each have a slope within this fraction
 /// of the fitted slope (or of `|σ|`, whichever is larger), plus
@@ -858,4 +858,38 @@ fn not_yet(
         lengthen_s: (end == RunEnd::Linear).then_some(lengthen),
         note,
     }
+}
+
+/// The document `summary.json` holds for a run of `sc` analysed as `an`:
+/// the integration (`integrator`, `events`, `stick_fraction`, `t_final`),
+/// `scenario`, `columns`, the tail `rms` of every velocity, `spectrum`,
+/// `growth_rate`, `verdict`, `verdict_detail`, `squeal` and `linear` (the
+/// [`Answer`] of the run), and `radiation` (its
+/// sound over the judged window, [`crate::sound`]). The CLI adds `audio` and
+/// `timing`.
+pub fn summary_json(sc: &Scenario, run: &Run, an: &Analysis) -> Value {
+    summary_json_with(sc, run, an, &Answer::of(sc, run, an))
+}
+
+/// [`summary_json`] with the run's answer already computed.
+pub fn summary_json_with(sc: &Scenario, run: &Run, an: &Analysis, answer: &Answer) -> Value {
+    let velocity_names: Vec<String> = {
+        let names = sc.model.state_names();
+        names[names.len() / 2..].to_vec()
+    };
+    let mut summary = crate::analysis::integrator_json(run);
+    summary["scenario"] = sc.to_json();
+    summary["columns"] = json!(run.columns);
+    summary["rms"] = json!(crate::analysis::tail_rms(run, &velocity_names));
+    summary["spectrum"] = an.spectrum_json();
+    summary["growth_rate"] = answer.growth_rate_json(an);
+    summary["verdict"] = json!(answer.verdict(an).as_str());
+    summary["verdict_detail"] = answer.verdict_detail_json(an);
+    summary["squeal"] = answer.squeal_json();
+    summary["linear"] = answer.linear_json();
+    summary["radiation"] = crate::sound::radiation_json(
+        &answer.sound,
+        answer.squeal.as_ref().map(|s| s.coordinate.as_str()),
+    );
+    summary
 }

@@ -1,7 +1,11 @@
 //! Errors, cancellation and progress for the long computations.
 
-use crate::scenario::InputError;
 use std::sync::atomic::{AtomicBool, Ordering};
+
+/// A bad scenario or override: one line naming the key and the value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct InputError(pub String);
 
 /// Why a study failed.
 #[derive(Debug, Clone, thiserror::Error)]

@@ -22,32 +22,7 @@ pub const MAX_SERIES_BYTES: f64 = 1024.0 * 1024.0 * 1024.0;
 /// about 2.4 bytes per series byte above a fixed 0.2 GB; 3 leaves a margin.
 pub const RUN_MEMORY_PER_SERIES_BYTE: f64 = 3.0;
 
-/// Below this many bytes (64 MiB) no memory check is made: every machine
-/// squeal runs on has that, and a map of small runs reads no `/proc` files.
-pub const MEMORY_CHECK_FROM: f64 = 64.0 * 1024.0 * 1024.0;
-
-/// Memory of the dense analyses of a lumped model with `n` dofs (bytes):
-/// its steady-sliding Jacobian (`n × 2n`), the state matrix or the
-/// projection's dense eigenproblem, as `300 n²`. Measured: a 500-dof model
-/// peaks at 68 MB, a 1000-dof one at 277 MB (`/usr/bin/time -f %M squeal
-/// stability`), 272–277 bytes per n².
-pub fn dense_analysis_bytes(n: usize) -> f64 {
-    300.0 * (n as f64) * (n as f64)
-}
-
-/// Refuse a lumped model whose dense analyses would not fit the memory
-/// this process may take, before anything is sized from its dof count.
-pub fn check_model_memory(dofs: usize) -> Result<(), InputError> {
-    let need = dense_analysis_bytes(dofs);
-    if need > MEMORY_CHECK_FROM {
-        crate::memory::check(
-            need,
-            &format!("a lumped model of {dofs} dofs (its dense steady-sliding and eigen-analysis)"),
-        )
-        .map_err(InputError)?;
-    }
-    Ok(())
-}
+pub use crate::memory::{check_model_memory, dense_analysis_bytes, MEMORY_CHECK_FROM};
 
 /// Most steps a run may need at the least (its [`min_steps`]): beyond this
 /// it would run for minutes (about 1 µs per step, and an accurate run takes
@@ -246,18 +221,8 @@ pub fn stability_failure(model: &AnyModel, e: StabilityError) -> StudyError {
     StudyError::Input(InputError(msg))
 }
 
-/// The samples and columns of `sc`'s series (time, states, derived columns).
-fn series_shape(sc: &Scenario) -> (f64, f64) {
-    let rows = sc.duration * sc.sample_rate + 2.0;
-    let cols = (1 + sc.model.state_names().len() + sc.model.derived_columns().len()) as f64;
-    (rows, cols)
-}
-
-/// The memory that `sc`'s series takes (bytes): samples × columns × 8.
-pub fn series_bytes(sc: &Scenario) -> f64 {
-    let (rows, cols) = series_shape(sc);
-    rows * cols * 8.0
-}
+pub use crate::run::series_bytes;
+use crate::run::series_shape;
 
 /// Check that `sc` can be run, before any work: the model is one squeal
 /// can simulate, the series fits in memory,
@@ -412,6 +377,23 @@ pub fn g(x: f64) -> String {
     } else {
         trim(format!("{:.5e}", x))
     }
+}
+
+/// [`crate::scenario::resolve`] for a run — with `duration` if given —
+/// checked the one way every simulating computation is ([`prepare`]:
+/// memory, sample rate, stiffness, and the step budget).
+pub fn resolve_run(
+    source: crate::scenario::Source<'_>,
+    sets: &[String],
+    duration: Option<f64>,
+) -> Result<Scenario, StudyError> {
+    let mut sc = crate::scenario::resolve(source, sets)?;
+    if let Some(d) = duration {
+        sc.apply("duration", &crate::scenario::Setting::Number(d))
+            .map_err(|e| InputError(format!("--duration: {}", e.0)))?;
+    }
+    prepare(&mut sc)?;
+    Ok(sc)
 }
 
 #[cfg(test)]

@@ -29,6 +29,7 @@ pub mod run;
 pub mod scenario;
 #[cfg(test)]
 mod scenario_props;
+pub mod sound;
 pub mod stability;
 pub mod study;
 pub mod sweep;

@@ -4,8 +4,8 @@
 //! (`spring 'disc_x': on: unknown dof 'x_q'`). Matrix Market files named in
 //! `[matrices]` are read relative to the scenario file's folder.
 
+use crate::error::InputError;
 use crate::matrix_file::MatrixInfo;
-use crate::scenario::InputError;
 use squeal_core::labelled::LabelledMatrix;
 use squeal_core::model::contact::Normal;
 use squeal_core::model::lumped::shared::Shared;

@@ -4,7 +4,7 @@
 //! readers of `squeal-core`: Matrix Market, Nastran DMIG, Abaqus
 //! `*MATRIX OUTPUT` and Harwell–Boeing (with ANSYS's mapping file).
 
-use crate::scenario::InputError;
+use crate::error::InputError;
 use squeal_core::labelled::LabelledMatrix;
 use squeal_core::model::lumped::Triplets;
 use std::path::{Path, PathBuf};

@@ -57,7 +57,7 @@ macro_rules! with_system {
 /// As [`with_system!`](crate::with_system), for simulation only: a lumped
 /// model of more than `MAX_EXACT_DOFS` (and at most `MAX_SIM_DOFS`) dofs runs
 /// padded with idle dofs (`squeal_core::model::lumped::padding`): run it
-/// with [`crate::run::sim_options`] and [`crate::run::initial_of`], and read
+/// with `run::sim_options` and `run::initial_of`, and read
 /// only its real states. Never for an eigen- or Floquet analysis (the idle
 /// dofs would add their modes).
 #[macro_export]

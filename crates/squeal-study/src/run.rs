@@ -266,7 +266,7 @@ pub fn explain(e: squeal_core::IntegrateError, duration: f64) -> String {
     }
 }
 
-/// Integrate a scenario (checked by [`crate::feasible::prepare`] first),
+/// Integrate a scenario (checked by `feasible::prepare` first),
 /// reporting thousandths of its duration to `progress`, stopping with
 /// [`StudyError::Interrupted`] soon after `cancel` is set.
 pub fn run(sc: &Scenario, progress: &dyn Progress, cancel: &Cancel) -> Result<Run, StudyError> {
@@ -289,7 +289,7 @@ pub fn tasks<S: Borrow<Scenario>>(scs: &[S]) -> Vec<std::ops::Range<usize>> {
     let mut out = Vec::new();
     let (mut start, mut bytes) = (0, 0.0);
     for (i, sc) in scs.iter().enumerate() {
-        let b = crate::feasible::series_bytes(sc.borrow());
+        let b = series_bytes(sc.borrow());
         if i > start && (i - start == lanes || bytes + b > TASK_SERIES_BYTES) {
             out.push(start..i);
             (start, bytes) = (i, 0.0);
@@ -383,4 +383,17 @@ pub fn run_many<S: Borrow<Scenario>>(
     out.into_iter()
         .map(|r| r.expect("every scenario ran"))
         .collect()
+}
+
+/// The samples (rows) and columns of `sc`'s series (time, states, derived columns).
+pub fn series_shape(sc: &Scenario) -> (f64, f64) {
+    let rows = sc.duration * sc.sample_rate + 2.0;
+    let cols = (1 + sc.model.state_names().len() + sc.model.derived_columns().len()) as f64;
+    (rows, cols)
+}
+
+/// The memory that `sc`'s series takes (bytes): samples × columns × 8.
+pub fn series_bytes(sc: &Scenario) -> f64 {
+    let (rows, cols) = series_shape(sc);
+    rows * cols * 8.0
 }

@@ -16,10 +16,7 @@ use squeal_core::{FrictionLaw, SolverOptions};
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// A bad scenario or override: one line naming the key and the value.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{0}")]
-pub struct InputError(pub String);
+pub use crate::error::InputError;
 
 fn err<T>(msg: impl Into<String>) -> Result<T, InputError> {
     Err(InputError(msg.into()))
@@ -307,7 +304,7 @@ impl Scenario {
         let lumped = model_name == "lumped";
         let model = if lumped {
             let (l, files) = crate::lumped_file::parse(table, base)?;
-            crate::feasible::check_model_memory(l.dof_count())?;
+            crate::memory::check_model_memory(l.dof_count())?;
             matrices = files;
             AnyModel::Lumped(Box::new(l))
         } else {
@@ -1180,22 +1177,5 @@ pub fn resolve(source: Source<'_>, sets: &[String]) -> Result<Scenario, InputErr
         Source::Table(t) => Scenario::from_table_in(t, None)?,
     };
     sc.apply_overrides(sets)?;
-    Ok(sc)
-}
-
-/// [`resolve`] for a run — with `duration` if given — checked the one way
-/// every simulating computation is ([`crate::feasible::prepare`]: memory,
-/// sample rate, stiffness, and the step budget).
-pub fn resolve_run(
-    source: Source<'_>,
-    sets: &[String],
-    duration: Option<f64>,
-) -> Result<Scenario, crate::StudyError> {
-    let mut sc = resolve(source, sets)?;
-    if let Some(d) = duration {
-        sc.apply("duration", &Setting::Number(d))
-            .map_err(|e| InputError(format!("--duration: {}", e.0)))?;
-    }
-    crate::feasible::prepare(&mut sc)?;
     Ok(sc)
 }

@@ -2,8 +2,9 @@
 //! shards): scenario sources agree, a grid's points do not depend on which
 //! others are computed with them, and a cancel token stops the work.
 
+use squeal_study::feasible::resolve_run;
 use squeal_study::map::{self, Axis};
-use squeal_study::scenario::{resolve, resolve_run, Source};
+use squeal_study::scenario::{resolve, Source};
 use squeal_study::{Cancel, NoProgress, StudyError};
 
 fn axes(model: &squeal_study::AnyModel, nx: usize, ny: usize) -> (Axis, Axis) {

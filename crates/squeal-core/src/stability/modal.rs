@@ -313,7 +313,8 @@ pub(crate) fn finish(mut modes: Vec<Eigen>, equilibrium: Vec<f64>) -> Analysis {
         least_stable: 0,
         equilibrium,
         eigen: modes,
-        method: super::projected::Method::Dense,
+        // Dense (the default); the projected analysis sets its own.
+        method: Default::default(),
     }
 }
 

@@ -93,7 +93,7 @@ pub fn resolve(args: &ScenarioArgs) -> Result<Scenario, InputError> {
 /// Resolve a scenario for a run — with `--duration` if given — and check it
 /// the one way every simulating command does ([`squeal_study::feasible::prepare`]).
 pub fn resolve_run(args: &ScenarioArgs, duration: Option<f64>) -> Result<Scenario, RunError> {
-    Ok(squeal_study::scenario::resolve_run(
+    Ok(squeal_study::feasible::resolve_run(
         Source::Spec(&args.scenario),
         &args.sets,
         duration,
@@ -143,7 +143,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
     );
     analysis::write_spectrum_csv(&an, &stage.path("spectrum.csv"))?;
     let answer = squeal_study::answer::Answer::of(&sc, &run, &an);
-    let mut summary = analysis::summary_json_with(&sc, &run, &an, &answer);
+    let mut summary = squeal_study::answer::summary_json_with(&sc, &run, &an, &answer);
     if !a.no_plots {
         let band = plot_settings.around_squeal(
             answer.squeal.as_ref().map(|s| s.frequency_hz),
@@ -187,7 +187,7 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
         if let Some(g) = answer.growth_line() {
             crate::outln!("{g}");
         }
-        crate::outln!("{}", squeal_study::radiation::sound_line(&answer.sound));
+        crate::outln!("{}", squeal_study::sound::sound_line(&answer.sound));
         if let Some(note) = answer
             .sound
             .as_ref()
