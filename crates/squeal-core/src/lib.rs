@@ -42,10 +42,13 @@ pub mod harwell_boeing;
 pub mod initial;
 pub mod integrate;
 pub mod labelled;
+pub mod lanes;
+pub mod linear;
 pub mod matrix_market;
 pub mod model;
 pub mod params;
 pub mod sink;
+pub mod solver_options;
 pub mod stability;
 
 pub use friction::FrictionLaw;

@@ -15,65 +15,19 @@
 
 pub mod budget;
 pub mod ensemble;
-pub mod lanes;
 pub mod roots;
 mod tableau;
 
+pub use crate::lanes;
 use crate::model::{EventKind, Guard, GuardKind, Guards, Mode, Modes, System};
+pub use crate::solver_options::{SolverOptions, MAX_STATES};
 use tableau::{A, B, C, D, E3, E5};
-
-/// Tuning knobs of the integrator. Times in seconds.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SolverOptions {
-    /// Relative tolerance (default 1e-8).
-    pub rtol: f64,
-    /// Absolute tolerance of position states (m); `None`: the model's default.
-    pub atol_pos: Option<f64>,
-    /// Absolute tolerance of velocity states (m/s); `None`: the model's default.
-    pub atol_vel: Option<f64>,
-    /// Per-state absolute tolerances, overriding `atol_pos`/`atol_vel` for
-    /// the states that have one (index = state index; at most [`MAX_STATES`]).
-    pub atol_state: [Option<f64>; MAX_STATES],
-    /// Largest step (s).
-    pub h_max: f64,
-    /// First step (s); `None`: chosen automatically (Hairer's rule).
-    pub h_init: Option<f64>,
-    /// Most accepted steps before the run is abandoned.
-    pub max_steps: u64,
-    /// Event location tolerance (s): roots are located to within
-    /// `max(event_tol, 1e-9·h)`; they are in practice refined to round-off.
-    pub event_tol: f64,
-    /// Two events closer than this (s) count as chatter…
-    pub zeno_gap: f64,
-    /// …and this many such events in a row end the run with [`IntegrateError::Chatter`].
-    pub zeno_count: u32,
-}
-
-impl Default for SolverOptions {
-    fn default() -> Self {
-        SolverOptions {
-            rtol: 1e-8,
-            atol_pos: None,
-            atol_vel: None,
-            atol_state: [None; MAX_STATES],
-            h_max: f64::INFINITY,
-            h_init: None,
-            max_steps: 500_000_000,
-            event_tol: 1e-12,
-            zeno_gap: 1e-13,
-            zeno_count: 100,
-        }
-    }
-}
 
 /// PI stabilisation of the step-size controller (0 = the elementary controller).
 const STEP_BETA: f64 = 0.04;
 
 /// Most mode changes in a row at one instant before it counts as chatter.
 const SETTLE_LIMIT: usize = 16;
-
-/// Most states a per-state tolerance can be given for.
-pub const MAX_STATES: usize = 16;
 
 /// Why a run stopped before its end.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

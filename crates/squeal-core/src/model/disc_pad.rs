@@ -10,7 +10,8 @@ use super::{
     Parameters,
 };
 use crate::friction::FrictionLaw;
-use crate::integrate::ensemble::{LaneField, Lanes, LANES};
+use crate::lanes::{Lanes, LANES};
+use crate::model::lane_field::LaneField;
 use crate::params::{ParamError, ParamKind, ParamSpec};
 
 /// Unilateral (the pad can lift off) or bilateral (never opens) contact.

@@ -38,8 +38,8 @@ use super::{
     EventKind, Guard, GuardKind, Guards, Mode, ModelError, Modes, Observables, System, MAX_CONTACTS,
 };
 use crate::friction::FrictionLaw;
+use crate::linear::{ModalOptions, SecondOrder};
 use crate::params::ParamError;
-use crate::stability::projected::{ModalOptions, SecondOrder};
 use nalgebra::DMatrix;
 
 /// A bad model description: one line naming the element and key.

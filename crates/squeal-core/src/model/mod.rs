@@ -1,7 +1,7 @@
 //! Models: vector fields per contact mode, event functions (guards) per mode,
 //! and the rules that pick the next mode when a guard fires.
 //!
-//! A model is a plug-in: the integrator ([`crate::integrate`]) knows nothing
+//! A model is a plug-in: the integrator (`integrate`) knows nothing
 //! of brakes. Every model here is mechanical, with state `z = (q, q̇)`, and
 //! every guard is affine in the state, `g(z) = c·z + d`, so along a step of the
 //! dense output it is a polynomial whose roots can all be found (MODEL.md §8).
@@ -10,6 +10,7 @@ pub mod belt;
 pub mod contact;
 pub mod disc_pad;
 pub mod hoffmann;
+pub mod lane_field;
 pub mod lumped;
 pub mod system;
 

@@ -74,8 +74,8 @@ impl Modes {
 }
 
 /// A frictional mechanical system with `N` states `(q, q̇)` and one or more
-/// contacts. The integrator ([`crate::integrate`]) and the stability analysis
-/// ([`crate::stability`]) are written against this trait; none of the methods
+/// contacts. The integrator (`integrate`) and the stability analysis
+/// (`stability`) are written against this trait; none of the methods
 /// the integrator calls in its inner loop may allocate.
 pub trait System<const N: usize>: Sync {
     /// Name as typed by users (`disc-pad`, `lumped`, …).

@@ -38,71 +38,9 @@ use super::{Analysis, StabilityError};
 use nalgebra::{Complex, DMatrix};
 use serde::Serialize;
 
-/// The highest frequency of interest for brake squeal (Hz): the top of the
-/// audible range.
-pub const BAND_HZ: f64 = 20_000.0;
-
-/// The default cut-off of the projection basis is this multiple of
-/// [`BAND_HZ`]: modes up to twice the highest frequency of interest, the
-/// usual rule for modal truncation (a mode's influence on the modes below
-/// falls off as `(f/f_k)²`).
-pub const CUTOFF_FACTOR: f64 = 2.0;
-
-/// Models with more dofs than this are analysed by projection unless told
-/// otherwise ([`ModalOptions::dense_max_dofs`]); a dense solve of 500 dofs
-/// (1000 states) takes about a second.
-pub const DEFAULT_DENSE_MAX_DOFS: usize = 500;
-
-/// How a model's complex eigenvalue analysis is solved. The `--set` keys of a
-/// lumped model are `modal.dense_max_dofs`, `modal.modes` and
-/// `modal.cutoff_hz`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct ModalOptions {
-    /// Models with at most this many dofs are solved dense (every
-    /// eigenvalue, exact to round-off); larger ones by projection. `0`:
-    /// always project; a large value: always dense.
-    pub dense_max_dofs: usize,
-    /// Keep exactly this many lowest undamped modes (`0`: use
-    /// [`ModalOptions::cutoff_hz`]).
-    pub modes: usize,
-    /// Keep every undamped mode up to this frequency (Hz).
-    pub cutoff_hz: f64,
-}
-
-impl Default for ModalOptions {
-    fn default() -> Self {
-        ModalOptions {
-            dense_max_dofs: DEFAULT_DENSE_MAX_DOFS,
-            modes: 0,
-            cutoff_hz: CUTOFF_FACTOR * BAND_HZ,
-        }
-    }
-}
-
-impl ModalOptions {
-    /// Whether a model of `dofs` dofs is solved by projection.
-    pub fn projects(&self, dofs: usize) -> bool {
-        dofs > self.dense_max_dofs
-    }
-    /// The projection basis these options ask for.
-    pub fn basis(&self) -> Basis {
-        if self.modes > 0 {
-            Basis::Modes(self.modes)
-        } else {
-            Basis::CutoffHz(self.cutoff_hz)
-        }
-    }
-}
-
-/// Which undamped modes span the projection basis.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Basis {
-    /// The `m` lowest (all of them if `m ≥ n`).
-    Modes(usize),
-    /// Every mode with `ω/2π ≤` this frequency (Hz); modes with `ω² ≤ 0` are
-    /// included.
-    CutoffHz(f64),
-}
+pub use crate::linear::{
+    Basis, ModalOptions, SecondOrder, BAND_HZ, CUTOFF_FACTOR, DEFAULT_DENSE_MAX_DOFS,
+};
 
 /// How an [`Analysis`] was computed (reported with it).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
@@ -125,18 +63,6 @@ pub enum Method {
         /// ([`with_static_correction`]).
         static_vectors: usize,
     },
-}
-
-/// The linearised second-order system `M q̈ + C q̇ + K q = 0` (each `n × n`,
-/// `M` symmetric positive definite).
-#[derive(Debug, Clone, PartialEq)]
-pub struct SecondOrder {
-    /// Mass matrix.
-    pub m: DMatrix<f64>,
-    /// Stiffness (`−∂force/∂q`), any symmetry.
-    pub k: DMatrix<f64>,
-    /// Damping (`−∂force/∂q̇`), any symmetry.
-    pub c: DMatrix<f64>,
 }
 
 /// An `M`-orthonormal basis of undamped modes: `Φ` (`n × m`, column `i` is

@@ -15,8 +15,9 @@
 
 use super::{DenseField, Fixed, FoldedContact, InvMass, Lumped, DENSE_FIELD_DOFS};
 use crate::friction::FrictionLaw;
-use crate::integrate::ensemble::{LaneField, Lanes, LANES};
+use crate::lanes::{Lanes, LANES};
 use crate::model::contact::Normal;
+use crate::model::lane_field::LaneField;
 use crate::model::{Mode, Modes, MAX_CONTACTS};
 
 const D: usize = DENSE_FIELD_DOFS;

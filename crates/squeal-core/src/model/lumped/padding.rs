@@ -20,7 +20,7 @@
 //! Floquet multipliers use the size-independent paths or the exact sizes.
 
 use super::{Combination, Lumped, Sparse, Spring};
-use crate::integrate::{SolverOptions, MAX_STATES};
+use crate::solver_options::{SolverOptions, MAX_STATES};
 
 /// Largest model (dofs) compiled at its exact state count.
 pub const MAX_EXACT_DOFS: usize = 16;
