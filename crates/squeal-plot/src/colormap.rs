@@ -15,16 +15,12 @@ const VIRIDIS: [[u8; 3]; 11] = [
     [0xFD, 0xE7, 0x25],
 ];
 
-/// ColorBrewer "RdBu" reversed: blue (negative, stable) – white (0) – red (positive).
-const RDBU_R: [[u8; 3]; 7] = [
-    [0x21, 0x66, 0xAC],
-    [0x67, 0xA9, 0xCF],
-    [0xD1, 0xE5, 0xF0],
-    [0xF7, 0xF7, 0xF7],
-    [0xFD, 0xDB, 0xC7],
-    [0xEF, 0x8A, 0x62],
-    [0xB2, 0x18, 0x2B],
-];
+/// The stable half of the diverging map: ColorBrewer "RdBu"'s blues, dark
+/// (most negative) to light (just below 0) — never white.
+const BLUES: [[u8; 3]; 3] = [[0x21, 0x66, 0xAC], [0x43, 0x93, 0xC3], [0x92, 0xC5, 0xDE]];
+
+/// The unstable half: its reds, light (0 and just above) to dark.
+const REDS: [[u8; 3]; 3] = [[0xF4, 0xA5, 0x82], [0xD6, 0x60, 0x4D], [0xB2, 0x18, 0x2B]];
 
 fn interpolate(points: &[[u8; 3]], t: f64) -> [u8; 3] {
     let t = if t.is_finite() {
@@ -49,9 +45,21 @@ pub(crate) fn sequential(t: f64) -> [u8; 3] {
     interpolate(&VIRIDIS, t)
 }
 
-/// Diverging map, `t` in `[0, 1]` (clamped) with white at 0.5.
+/// Diverging map, `t` in `[0, 1]` (clamped), centred at 0.5: blues below
+/// (stable), reds from 0.5 up (unstable), both sides coloured — no white
+/// that a stable cell would share with the background — and the sign
+/// change a visible step.
 pub(crate) fn diverging(t: f64) -> [u8; 3] {
-    interpolate(&RDBU_R, t)
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    if t < 0.5 {
+        interpolate(&BLUES, 2.0 * t)
+    } else {
+        interpolate(&REDS, 2.0 * t - 1.0)
+    }
 }
 
 /// Qualitative palette for categories (ColorBrewer "Set1" without yellow, then "Dark2"):
@@ -83,8 +91,29 @@ mod tests {
         assert_eq!(sequential(0.0), VIRIDIS[0]);
         assert_eq!(sequential(1.0), VIRIDIS[10]);
         assert_eq!(sequential(7.0), VIRIDIS[10]);
-        assert_eq!(diverging(0.5), [0xF7, 0xF7, 0xF7]);
-        assert_eq!(diverging(-1.0), RDBU_R[0]);
+        assert_eq!(diverging(0.5), REDS[0]);
+        assert_eq!(diverging(0.4999), [0x92, 0xC5, 0xDE]);
+        assert_eq!(diverging(-1.0), BLUES[0]);
+        assert_eq!(diverging(1.0), REDS[2]);
         let _ = sequential(f64::NAN);
+    }
+
+    /// Neither side of σ = 0 is white or near the white background: every
+    /// colour of the map is at least 60 (of 255) from white in some channel
+    /// sum sense, and the two sides of 0 differ clearly.
+    #[test]
+    fn diverging_is_coloured_on_both_sides_of_zero() {
+        let dist = |a: [u8; 3], b: [u8; 3]| {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| (*x as f64 - y as f64).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        };
+        for k in 0..=1000 {
+            let c = diverging(k as f64 / 1000.0);
+            assert!(dist(c, [255, 255, 255]) > 90.0, "{k}: {c:?} is near white");
+        }
+        assert!(dist(diverging(0.4999), diverging(0.5)) > 100.0);
     }
 }

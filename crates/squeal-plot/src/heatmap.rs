@@ -14,7 +14,9 @@ use crate::colormap;
 use crate::contour::{zero_contour, Segment};
 use crate::lines::axis_range;
 use crate::output::{emit, Figure, Raster, RasterMode, PLACEHOLDER};
-use crate::style::{draw_label, draw_note, fmt_tick, font, nice_ticks, Theme, INK, NAN_GREY};
+use crate::style::{
+    draw_label, draw_note, fmt_eng, fmt_tick, font, nice_ticks, Theme, INK, NAN_GREY,
+};
 use crate::{Format, PlotError};
 
 /// Colour scheme of a [`heatmap`].
@@ -23,7 +25,7 @@ pub enum Colormap {
     /// Dark-to-bright (viridis approximation), for magnitudes such as dB.
     #[default]
     Sequential,
-    /// Blue–white–red, symmetric about 0 (white at 0, red positive), for signed
+    /// Blues below 0, reds from 0 up (both sides coloured, never white), centred on 0, for signed
     /// quantities such as the growth rate σ.
     Diverging,
 }
@@ -520,17 +522,17 @@ impl HeatFigure<'_> {
         let mut max_w = 0;
         let mut ticks: Vec<(f64, String)> = nice_ticks(lo, hi, 6)
             .into_iter()
-            .map(|v| (v, fmt_tick(v)))
+            .map(|v| (v, fmt_eng(v)))
             .collect();
         // The saturated ends are labelled with their value, marked ≥ / ≤.
         let near = |v: f64, end: f64| (v - end).abs() < 0.06 * (hi - lo);
         if self.clipped.1 {
             ticks.retain(|(v, _)| !near(*v, hi));
-            ticks.push((hi, format!("≥ {}", fmt_tick(hi))));
+            ticks.push((hi, format!("≥ {}", fmt_eng(hi))));
         }
         if self.clipped.0 {
             ticks.retain(|(v, _)| !near(*v, lo));
-            ticks.push((lo, format!("≤ {}", fmt_tick(lo))));
+            ticks.push((lo, format!("≤ {}", fmt_eng(lo))));
         }
         for (v, text) in ticks {
             let q = to_px(v);

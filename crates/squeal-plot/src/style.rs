@@ -46,7 +46,8 @@ pub(crate) const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
+    // Teal, not the category palette's red: red is the highlight (MARKER).
+    RGBColor(23, 190, 207),
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
     RGBColor(227, 119, 194),
@@ -117,6 +118,46 @@ fn trim_zeros(s: &str) -> &str {
         s.trim_end_matches('0').trim_end_matches('.')
     } else {
         s
+    }
+}
+
+/// A value in engineering notation with an SI prefix and three significant
+/// digits, for colourbars: `1134.263806` → `"1.13 k"`, `0.25` → `"250 m"`,
+/// `-40` → `"-40"`, `3.2e-6` → `"3.2 µ"`; `"0"` at zero.
+pub(crate) fn fmt_eng(v: f64) -> String {
+    const PREFIXES: [&str; 9] = ["f", "p", "n", "µ", "m", "", "k", "M", "G"];
+    if !v.is_finite() {
+        return String::new();
+    }
+    let a = v.abs();
+    if a < 1e-15 {
+        return "0".to_string();
+    }
+    let mut e = ((a.log10() / 3.0).floor() as i32).clamp(-5, 3);
+    let mut m = a / 10f64.powi(3 * e);
+    let digits = |m: f64| {
+        if m >= 100.0 {
+            0
+        } else if m >= 10.0 {
+            1
+        } else {
+            2
+        }
+    };
+    let mut text = format!("{:.*}", digits(m), m);
+    // Rounding may reach the next prefix: 999.7 → "1000" → "1 k".
+    if text.parse::<f64>().unwrap_or(0.0) >= 1000.0 && e < 3 {
+        e += 1;
+        m /= 1000.0;
+        text = format!("{:.*}", digits(m), m);
+    }
+    let sign = if v < 0.0 { "-" } else { "" };
+    let prefix = PREFIXES[(e + 5) as usize];
+    let number = trim_zeros(&text);
+    if prefix.is_empty() {
+        format!("{sign}{number}")
+    } else {
+        format!("{sign}{number} {prefix}")
     }
 }
 
@@ -229,6 +270,33 @@ mod tests {
         assert_eq!(fmt_tick(0.0002), "2e-4");
         assert_eq!(fmt_tick(250000.0), "2.5e5");
         assert_eq!(fmt_tick(1e-17), "0");
+    }
+
+    #[test]
+    fn engineering_notation() {
+        assert_eq!(fmt_eng(1134.263806), "1.13 k");
+        assert_eq!(fmt_eng(0.25), "250 m");
+        assert_eq!(fmt_eng(-40.0), "-40");
+        assert_eq!(fmt_eng(3.2e-6), "3.2 µ");
+        assert_eq!(fmt_eng(0.0), "0");
+        assert_eq!(fmt_eng(999.7), "1 k");
+        assert_eq!(fmt_eng(118.0), "118");
+        assert_eq!(fmt_eng(-80.0), "-80");
+        assert_eq!(fmt_eng(2.5e7), "25 M");
+        assert_eq!(fmt_eng(1.0), "1");
+    }
+
+    #[test]
+    fn the_palette_never_uses_the_highlight_red() {
+        let d = |a: RGBColor, b: RGBColor| {
+            ((a.0 as f64 - b.0 as f64).powi(2)
+                + (a.1 as f64 - b.1 as f64).powi(2)
+                + (a.2 as f64 - b.2 as f64).powi(2))
+            .sqrt()
+        };
+        for c in PALETTE {
+            assert!(d(c, MARKER) >= 80.0, "{c:?} is too close to the highlight");
+        }
     }
 
     #[test]

@@ -174,6 +174,29 @@ pub struct SquealAnswer {
     pub note: String,
 }
 
+/// The squeal in a few words, for the pictures' titles: "squeal 2.2508 kHz
+/// ± 4.0 Hz" (measured), or "squeal not established: linear prediction
+/// 2.25076 kHz" (`source` = `linear`).
+pub fn squeal_words(frequency_hz: f64, uncertainty_hz: Option<f64>, source: &str) -> String {
+    if source == Source::Linear.as_str() {
+        return format!(
+            "squeal not established: linear prediction {}",
+            si(frequency_hz, "Hz", 6)
+        );
+    }
+    match uncertainty_hz {
+        Some(u) => format!("squeal {} ± {}", si(frequency_hz, "Hz", 5), si(u, "Hz", 2)),
+        None => format!("squeal {}", si(frequency_hz, "Hz", 5)),
+    }
+}
+
+impl SquealAnswer {
+    /// [`squeal_words`] of this answer.
+    pub fn words(&self) -> String {
+        squeal_words(self.frequency_hz, self.uncertainty_hz, self.source.as_str())
+    }
+}
+
 /// The answer of a run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Answer {

@@ -195,14 +195,15 @@ pub fn squeal_answer(answer: &crate::answer::Answer) -> Option<SquealAnswer> {
 }
 
 /// Measure one set: its eigenvalues, a run and its analysis, and the
-/// numbers the conclusions need. `after` sees the run and its analysis
-/// before they are dropped (the CLI draws Appendix A's pictures there).
+/// numbers the conclusions need. `after` sees the run, its analysis and
+/// its answer before they are dropped (the CLI draws Appendix A's pictures
+/// there).
 /// [`measure_run`] of [`run::run`](crate::run::run)'s run of `sc`.
 pub fn measure<E: From<StudyError>>(
     id: usize,
     sc: Scenario,
     cancel: &Cancel,
-    after: impl Fn(&Run, &Analysis) -> Result<(), E>,
+    after: impl Fn(&Run, &Analysis, &crate::answer::Answer) -> Result<(), E>,
 ) -> Result<SetResult, E> {
     let run: Run = crate::run::run(&sc, &NoProgress, cancel)?;
     measure_run(id, sc, run, after)
@@ -215,7 +216,7 @@ pub fn measure_run<E: From<StudyError>>(
     id: usize,
     sc: Scenario,
     run: Run,
-    after: impl Fn(&Run, &Analysis) -> Result<(), E>,
+    after: impl Fn(&Run, &Analysis, &crate::answer::Answer) -> Result<(), E>,
 ) -> Result<SetResult, E> {
     let (linear, linear_note) = match linear_of(&sc.model) {
         Ok(l) => (Some(l), String::new()),
@@ -229,9 +230,9 @@ pub fn measure_run<E: From<StudyError>>(
         sc.validity,
         &[],
     );
-    after(&run, &an)?;
     // One answer: the verdict and squeal `simulate` gives for this run.
     let answer = crate::answer::Answer::of(&sc, &run, &an);
+    after(&run, &an, &answer)?;
     let col = |n: &str| run.column(n).unwrap_or(&[]);
     let vxd = col("vx_d");
     let n = vxd.len();
@@ -1216,7 +1217,7 @@ mod tests {
         // Set 1 (no steady sliding) and set 15 (sliding, with modes), short runs.
         let sets = prepared_sets(0.02).unwrap();
         for i in [0usize, 14, 36] {
-            let r = measure(i + 1, sets[i].clone(), &Cancel::new(), |_, _| {
+            let r = measure(i + 1, sets[i].clone(), &Cancel::new(), |_, _, _| {
                 Ok::<(), StudyError>(())
             })
             .unwrap();

@@ -164,11 +164,67 @@ fn freq_unit(f_hi: f64) -> (f64, &'static str) {
     }
 }
 
-/// Write the pictures of a run into `dir`: `triplet` (each analysed velocity
+/// Most velocities the triplet shows unless `--signals` names them (two
+/// panels each: 8 panels, 2400 pixels high).
+pub const MAX_SHOWN_SIGNALS: usize = 4;
+
+/// The velocities the triplet shows, in the order shown: all analysed ones
+/// when `explicit` (`--signals`) or when there are at most
+/// [`MAX_SHOWN_SIGNALS`]; otherwise the squealing velocity first, then the
+/// contact's tangential and normal ones (when they move), then the others
+/// by RMS over the run.
+pub fn shown_signals<'a>(
+    run: &Run,
+    an: &'a Analysis,
+    ch: &Channels,
+    explicit: bool,
+) -> Vec<&'a ChannelSpectrum> {
+    let all: Vec<&ChannelSpectrum> = an.spectra.iter().collect();
+    if explicit || all.len() <= MAX_SHOWN_SIGNALS {
+        return all;
+    }
+    let rms = |s: &str| {
+        run.column(s).map_or(0.0, |x| {
+            (x.iter().map(|v| v * v).sum::<f64>() / x.len().max(1) as f64).sqrt()
+        })
+    };
+    let mut first: Vec<&str> = Vec::new();
+    if let Some(q) = &an.judgement.squeal {
+        first.push(q.velocity.as_str());
+    }
+    first.push(ch.tangential.as_str());
+    if let Some(n) = &ch.normal {
+        first.push(n.as_str());
+    }
+    let mut order: Vec<&ChannelSpectrum> = Vec::new();
+    // A contact velocity that never moves (a symmetric two-pad disc's
+    // normal one) gives its place to one that does.
+    for f in first.into_iter().filter(|f| rms(f) > 0.0) {
+        if let Some(c) = all.iter().find(|c| c.signal == f) {
+            if !order.iter().any(|o| o.signal == c.signal) {
+                order.push(c);
+            }
+        }
+    }
+    let mut rest: Vec<&ChannelSpectrum> = all
+        .iter()
+        .copied()
+        .filter(|c| !order.iter().any(|o| o.signal == c.signal))
+        .collect();
+    rest.sort_by(|a, b| rms(&b.signal).total_cmp(&rms(&a.signal)));
+    order.extend(rest);
+    order.truncate(MAX_SHOWN_SIGNALS);
+    order
+}
+
+/// Write the pictures of a run into `dir`: `triplet` (each shown velocity
 /// against time, then its spectrum: the thesis's pictures, with the pad's
-/// velocities too), `spectrogram` (of the squealing velocity) and `phase`
-/// (phase portrait of the squealing coordinate), as PNG and SVG. Axes carry SI
-/// prefixes (µm/s, kHz); `plot` limits and scales the frequency axes.
+/// velocities too; [`shown_signals`]), `spectrogram` (of the squealing
+/// velocity) and `phase` (phase portrait of the squealing coordinate), as
+/// PNG and SVG. Axes carry SI prefixes (µm/s, kHz); `plot` limits and scales
+/// the frequency axes; `squeal` (the run's answer in words, e.g. "squeal
+/// 2.2508 kHz ± 4.0 Hz") titles the spectrogram and the squealing
+/// velocity's spectrum. Returns a note when velocities were left out.
 pub fn draw(
     run: &Run,
     an: &Analysis,
@@ -176,11 +232,30 @@ pub fn draw(
     title: &str,
     dir: &Path,
     plot: &PlotSettings,
-) -> Result<(), RunError> {
+    squeal: Option<&str>,
+    explicit_signals: bool,
+) -> Result<Option<String>, RunError> {
     let plot_err = |e: squeal_plot::PlotError| RunError::Io(format!("drawing failed: {e}"));
     let formats = [Format::Png, Format::Svg];
     let t = run.column("t").unwrap_or(&[]);
-    let chans: Vec<&ChannelSpectrum> = an.spectra.iter().collect();
+    let chans = shown_signals(run, an, ch, explicit_signals);
+    let left_out = (chans.len() < an.spectra.len()).then(|| {
+        format!(
+            "triplet: {} of the {} velocities ({}); --signals draws others",
+            chans.len(),
+            an.spectra.len(),
+            chans
+                .iter()
+                .map(|c| c.signal.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    });
+    let squeal_velocity = an.judgement.squeal.as_ref().map(|q| q.velocity.as_str());
+    let marked = |signal: &str, text: String| match squeal {
+        Some(s) if Some(signal) == squeal_velocity => format!("{text} — {s}"),
+        _ => text,
+    };
     // Each velocity against time on its own axis (their sizes differ by orders
     // of magnitude), scaled to an SI prefix.
     struct Shown {
@@ -234,18 +309,21 @@ pub fn draw(
                 })
                 .collect();
             Spec {
-                title: match velocity_words(&c.signal) {
-                    Some(w) => format!(
-                        "{what} of {} ({w}, {} window)",
-                        c.signal,
-                        c.spectrum.window.name()
-                    ),
-                    None => format!(
-                        "{what} of {} ({} window)",
-                        c.signal,
-                        c.spectrum.window.name()
-                    ),
-                },
+                title: marked(
+                    &c.signal,
+                    match velocity_words(&c.signal) {
+                        Some(w) => format!(
+                            "{what} of {} ({w}, {} window)",
+                            c.signal,
+                            c.spectrum.window.name()
+                        ),
+                        None => format!(
+                            "{what} of {} ({} window)",
+                            c.signal,
+                            c.spectrum.window.name()
+                        ),
+                    },
+                ),
                 y_label: if c.spectrum.scaling == Scaling::Amplitude {
                     "amplitude (dB re 1 m/s)"
                 } else {
@@ -300,9 +378,12 @@ pub fn draw(
             (seg / 4).max(1),
             squeal_signal::window::Window::Hann,
         ) {
-            let title = format!(
-                "{title}: spectrogram of {sg_signal}{}",
-                velocity_words_paren(&sg_signal)
+            let title = marked(
+                &sg_signal,
+                format!(
+                    "{title}: spectrogram of {sg_signal}{}",
+                    velocity_words_paren(&sg_signal)
+                ),
             );
             let rows: Vec<usize> = (0..sg.n_freqs())
                 .filter(|&k| {
@@ -393,7 +474,7 @@ pub fn draw(
         )
         .map_err(plot_err)?;
     }
-    Ok(())
+    Ok(left_out)
 }
 
 /// The level reference of every WAV squeal writes: a velocity of

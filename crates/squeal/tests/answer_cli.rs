@@ -217,3 +217,69 @@ fn a_round_off_sigma_is_neutral_not_growing() {
     assert_eq!(v["verdict"], "neutral");
     assert!(v["squeal"].is_null(), "{}", v["squeal"]);
 }
+
+/// Pictures for any number of dofs (issue 28 §5): the 8-dof caliper's
+/// triplet shows four velocities by default — the squealing one first —
+/// in 8 panels 2400 px high, says which on stderr, and `--signals` still
+/// draws any set; the squeal's title carries the very number of
+/// summary.json.
+#[test]
+fn an_eight_dof_triplet_shows_the_squeal_first_and_says_what_it_left_out() {
+    let d = tempfile::tempdir().unwrap();
+    let out = crate::cli_common::squeal(
+        d.path(),
+        &[
+            "simulate",
+            "floating-caliper",
+            "--duration",
+            "0.2",
+            "--out",
+            "a",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("triplet: 4 of the 8 velocities (vx_p1, "),
+        "{err}"
+    );
+    let png = std::fs::read(d.path().join("a/triplet.png")).unwrap();
+    let height = u32::from_be_bytes([png[20], png[21], png[22], png[23]]);
+    assert_eq!(height, 2400);
+    let summary: Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("a/summary.json")).unwrap())
+            .unwrap();
+    let words = squeal_words(&summary["squeal"]);
+    let svg = std::fs::read_to_string(d.path().join("a/spectrogram.svg")).unwrap();
+    assert!(
+        svg.contains(&words),
+        "{words} not in the spectrogram's title"
+    );
+    let out = crate::cli_common::squeal(
+        d.path(),
+        &[
+            "simulate",
+            "floating-caliper",
+            "--duration",
+            "0.05",
+            "--out",
+            "b",
+            "--signals",
+            "vx_d,vy_d,vx_p1,vy_p1,vx_p2,vy_p2",
+        ],
+    );
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("triplet:"));
+    let png = std::fs::read(d.path().join("b/triplet.png")).unwrap();
+    let height = u32::from_be_bytes([png[20], png[21], png[22], png[23]]);
+    assert_eq!(height, 3600, "6 velocities asked for, 12 panels");
+}
+
+/// "squeal 2.2508 kHz ± 4.0 Hz" from summary.json's squeal, as the
+/// pictures write it (SI prefix, 5 and 2 significant digits).
+fn squeal_words(s: &Value) -> String {
+    let (hz, u) = (f(&s["frequency_hz"]), f(&s["uncertainty_hz"]));
+    assert!(
+        (1000.0..10_000.0).contains(&hz) && (1.0..10.0).contains(&u),
+        "{s}"
+    );
+    format!("squeal {:.4} kHz ± {:.1} Hz", hz / 1000.0, u)
+}

@@ -38,7 +38,26 @@ pub fn run(a: PlotArgs) -> Result<(), RunError> {
     // squeal wrote (or none) in the run folder.
     let scratch = crate::staging::Staging::scratch(&a.run_dir)?;
     let plot = plot.around_squeal(summary["squeal"]["frequency_hz"].as_f64(), run.sample_rate);
-    analysis::draw(&run, &an, &channels, &name, scratch.dir(), &plot)?;
+    let q = &summary["squeal"];
+    let words = q["frequency_hz"].as_f64().map(|f| {
+        squeal_study::answer::squeal_words(
+            f,
+            q["uncertainty_hz"].as_f64(),
+            q["source"].as_str().unwrap_or("run"),
+        )
+    });
+    if let Some(note) = analysis::draw(
+        &run,
+        &an,
+        &channels,
+        &name,
+        scratch.dir(),
+        &plot,
+        words.as_deref(),
+        !a.spectrum.signals().is_empty(),
+    )? {
+        crate::errln!("{note}");
+    }
     analysis::write_spectrum_csv(&an, &scratch.path("spectrum.csv"))?;
     // summary.json says what the redrawn pictures and spectrum.csv show.
     summary["spectrum"] = an.spectrum_json();

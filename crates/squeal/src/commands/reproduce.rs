@@ -29,6 +29,7 @@ fn draw_set(
     id: usize,
     run: &Run,
     an: &Analysis,
+    answer: &squeal_study::answer::Answer,
     ch: &squeal_study::model::Channels,
     figures: Option<&Path>,
 ) -> Result<(), RunError> {
@@ -38,6 +39,7 @@ fn draw_set(
     let d = dir.join(format!("set{id:02}"));
     std::fs::create_dir_all(&d)
         .map_err(|e| RunError::Io(format!("cannot create {}: {e}", d.display())))?;
+    let words = answer.squeal.as_ref().map(|s| s.words());
     analysis::draw(
         run,
         an,
@@ -45,7 +47,10 @@ fn draw_set(
         &format!("set {id}"),
         &d,
         &analysis::PlotSettings::default(),
+        words.as_deref(),
+        false,
     )
+    .map(|_| ())
 }
 
 /// Arguments of `squeal reproduce`.
@@ -856,8 +861,8 @@ fn measure_sets(
                     let sc = sets[i].clone();
                     let ch = sc.model.channels();
                     let r = run.map_err(RunError::from).and_then(|run| {
-                        measure_run(i + 1, sc, run, |run, an| {
-                            draw_set(i + 1, run, an, &ch, figures)
+                        measure_run(i + 1, sc, run, |run, an, answer| {
+                            draw_set(i + 1, run, an, answer, &ch, figures)
                         })
                     });
                     squeal_study::Progress::inc(&pb, 1);

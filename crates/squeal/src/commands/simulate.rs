@@ -149,7 +149,19 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
             answer.squeal.as_ref().map(|s| s.frequency_hz),
             run.sample_rate,
         );
-        analysis::draw(&run, &an, &channels, &sc.name, stage.dir(), &band)?;
+        let words = answer.squeal.as_ref().map(|s| s.words());
+        if let Some(note) = analysis::draw(
+            &run,
+            &an,
+            &channels,
+            &sc.name,
+            stage.dir(),
+            &band,
+            words.as_deref(),
+            !a.spectrum.signals().is_empty(),
+        )? {
+            crate::errln!("{note}");
+        }
     }
     let mut hearing = None;
     if a.wav {
