@@ -31,6 +31,7 @@ mod scenario_props;
 pub mod stability;
 pub mod study;
 pub mod sweep;
+pub mod validate;
 
 pub use error::{Cancel, NoProgress, Progress, StudyError};
 pub use model::AnyModel;
