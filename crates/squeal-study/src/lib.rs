@@ -33,6 +33,7 @@ pub mod sound;
 pub mod stability;
 pub mod study;
 pub mod sweep;
+pub mod validate;
 
 pub use error::{Cancel, NoProgress, Progress, StudyError};
 pub use model::AnyModel;

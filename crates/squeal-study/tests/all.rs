@@ -4,3 +4,4 @@
 
 mod library;
 mod run_many;
+mod validate;

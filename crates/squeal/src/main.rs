@@ -51,6 +51,8 @@ enum Command {
         #[command(subcommand)]
         what: commands::slurm::SlurmCmd,
     },
+    /// Run squeal's benchmark cases against analytic, published or independent references.
+    Validate(commands::validate::ValidateArgs),
     /// Locate the parameter value where steady sliding changes stability.
     Critical(commands::critical::CriticalArgs),
     /// The limit cycle a scenario settles on: period, Floquet multipliers, amplitudes, events.
@@ -143,6 +145,7 @@ fn dispatch(command: Command) -> Result<(), RunError> {
         Command::Merge(a) => commands::merge::run(a),
         Command::Slurm { what } => commands::slurm::run(what),
         Command::Critical(a) => commands::critical::run(a),
+        Command::Validate(a) => commands::validate::run(a),
         Command::Sweep(a) => commands::sweep::run(a),
         Command::Listen(a) => commands::listen::run(a),
         Command::Cycle(a) => commands::cycle::run(a),

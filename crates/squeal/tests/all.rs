@@ -22,4 +22,5 @@ mod shard_cli;
 mod signals;
 mod stability_cli;
 mod sweep_cli;
+mod validate_cli;
 mod verdict;

@@ -14,3 +14,4 @@ pub mod simulate;
 pub mod slurm;
 pub mod stability;
 pub mod sweep;
+pub mod validate;

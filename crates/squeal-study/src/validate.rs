@@ -1,0 +1,390 @@
+//! `squeal validate`: squeal's benchmark cases, each computed with squeal's
+//! own library at run time and compared with a reference that is analytic
+//! (a formula, evaluated here), published, or independently computed (a
+//! different method, also run here). A case compared only with squeal's own
+//! earlier number would be [`Kind::Regression`], never validation.
+//!
+//! No case holds a computed value: every `value` and every formula
+//! `reference` is evaluated when [`run`] is called.
+
+use crate::error::Progress;
+use serde::Serialize;
+use squeal_core::cycle::{find_cycle, CycleOptions};
+use squeal_core::model::hoffmann::Hoffmann;
+use squeal_core::sink::EventLog;
+use squeal_core::stability::{critical, max_growth_rate, CriticalOptions, StabilityError};
+use squeal_core::{simulate, Belt, DiscPad, EventKind, FrictionLaw, Parameters, SolverOptions};
+
+/// What a case's reference is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Kind {
+    /// A formula derived from the model's equations, evaluated in code.
+    Analytic,
+    /// A number published by someone else (a paper, a solver's output).
+    Published,
+    /// The same quantity by an independent method, computed at run time.
+    Independent,
+    /// Only squeal's own earlier number: not validation.
+    Regression,
+}
+
+/// How a case's error is measured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ErrorKind {
+    /// `|value − reference| / |reference|`.
+    Relative,
+    /// `|value − reference|` (for a reference that is 0).
+    Absolute,
+}
+
+/// One benchmark case, computed.
+#[derive(Debug, Clone, Serialize)]
+pub struct Case {
+    /// Short name, e.g. `hoffmann-mu-undamped`.
+    pub name: &'static str,
+    /// What the reference is.
+    pub kind: Kind,
+    /// The quantity compared, in words.
+    pub quantity: &'static str,
+    /// Its unit (`"1"` for a dimensionless number).
+    pub unit: &'static str,
+    /// The reference value.
+    pub reference: f64,
+    /// Where the reference comes from: paper or formula, with its equation.
+    pub source: &'static str,
+    /// squeal's value (NaN when its computation failed; see `detail`).
+    pub value: f64,
+    /// The error, as `error_kind` says.
+    pub error: f64,
+    /// Relative or absolute.
+    pub error_kind: ErrorKind,
+    /// The largest error that passes.
+    pub tolerance: f64,
+    /// `error ≤ tolerance` with a finite value and reference.
+    pub pass: bool,
+    /// Why the computation failed, if it did.
+    pub detail: Option<String>,
+}
+
+/// A case before it is computed: its labels and the function that returns
+/// `(reference, value)`.
+pub struct Spec {
+    /// See [`Case::name`].
+    pub name: &'static str,
+    /// See [`Case::kind`].
+    pub kind: Kind,
+    /// See [`Case::quantity`].
+    pub quantity: &'static str,
+    /// See [`Case::unit`].
+    pub unit: &'static str,
+    /// See [`Case::source`].
+    pub source: &'static str,
+    /// See [`Case::tolerance`] (relative).
+    pub tolerance: f64,
+    /// Computes `(reference, value)`.
+    pub compute: fn() -> Result<(f64, f64), String>,
+}
+
+/// Every case, in the order `squeal validate` prints them.
+pub fn specs() -> Vec<Spec> {
+    vec![
+        Spec {
+            name: "belt-coulomb-period",
+            kind: Kind::Analytic,
+            quantity: "stick-slip period, belt with Coulomb friction (shooting)",
+            unit: "s",
+            source: "closed form T = 2(x_s − x_k)/V + (π + 2 atan2(V/ω, x_s − x_k))/ω, \
+                     docs/physics.md §5a′",
+            tolerance: 1e-7,
+            compute: belt_coulomb_period,
+        },
+        Spec {
+            name: "belt-hopf-speed",
+            kind: Kind::Analytic,
+            quantity: "Hopf speed of steady sliding, belt with the thesis law (c = 0.2, N = 100)",
+            unit: "m/s",
+            source: "V_H = Uc (1 − c/(N f0 f1)), docs/physics.md §5 (thesis eq. 12.1)",
+            tolerance: 1e-8,
+            compute: belt_hopf_speed,
+        },
+        Spec {
+            name: "disc-pad-hopf-speed",
+            kind: Kind::Analytic,
+            quantity: "Hopf speed of the thesis disc–pad's pad mode (α = 0, N = 500)",
+            unit: "m/s",
+            source: "V_H = Uc (1 − c_px/(N f0 f1)), docs/physics.md §5 (the pad's \
+                     one-oscillator criterion c_px + F_y* μ′(V) = 0, thesis eq. 12.1)",
+            tolerance: 1e-8,
+            compute: disc_pad_hopf_speed,
+        },
+        Spec {
+            name: "hoffmann-mu-undamped",
+            kind: Kind::Analytic,
+            quantity: "critical friction coefficient, Hoffmann 2-dof, c1 = c2 = 0",
+            unit: "1",
+            source: "μ_c = ((k11 − k22)² + 4 k12²)/(4 k12 k3): coalescence, Hoffmann, Fischer, \
+                     Allgaier & Gaul 2002, Mech. Res. Commun. 29; docs/physics.md §5a",
+            tolerance: 1e-8,
+            compute: hoffmann_undamped,
+        },
+        Spec {
+            name: "hoffmann-mu-damped",
+            kind: Kind::Analytic,
+            quantity: "critical friction coefficient, Hoffmann 2-dof, c1 = c2 = 0.5 kg/s",
+            unit: "1",
+            source: "Routh–Hurwitz H = a3 a2 a1 − a4 a1² − a3² a0(μ) = 0 on det(m s² + C s + \
+                     K(μ)), docs/physics.md §5a",
+            tolerance: 1e-8,
+            compute: || hoffmann_damped(0.5, 0.5),
+        },
+        Spec {
+            name: "hoffmann-mu-damped-unequal",
+            kind: Kind::Analytic,
+            quantity: "critical friction coefficient, Hoffmann 2-dof, c1 = 0.1, c2 = 1 kg/s \
+                       (below μ_c: damping destabilises)",
+            unit: "1",
+            source: "Routh–Hurwitz H = a3 a2 a1 − a4 a1² − a3² a0(μ) = 0 on det(m s² + C s + \
+                     K(μ)), docs/physics.md §5a",
+            tolerance: 1e-8,
+            compute: || hoffmann_damped(0.1, 1.0),
+        },
+        Spec {
+            name: "leine-rational-period",
+            kind: Kind::Independent,
+            quantity: "stick-slip period, belt with μ = 1/(1 + 3|v|), m = k = N = 1, V = 0.2 \
+                       (shooting vs a 400 s simulation's stick spacing)",
+            unit: "s",
+            source: "model of Leine, van Campen, de Kraker & van den Steen 1998, Nonlinear \
+                     Dyn. 16, 41–54; the reference is the mean stick-to-stick time of a long \
+                     event-driven simulation",
+            tolerance: 1e-6,
+            compute: leine_period,
+        },
+    ]
+}
+
+/// Run every case whose name contains `filter` (all when `None`), one
+/// `progress.inc(1)` per case. A case whose computation fails is reported
+/// failed with its reason in `detail`; nothing panics.
+pub fn run(filter: Option<&str>, progress: &dyn Progress) -> Vec<Case> {
+    let mut out = Vec::new();
+    for s in specs() {
+        if let Some(f) = filter {
+            if !s.name.contains(f) {
+                continue;
+            }
+        }
+        out.push(evaluate(&s));
+        progress.inc(1);
+    }
+    progress.finish();
+    out
+}
+
+/// Compute one case.
+pub fn evaluate(s: &Spec) -> Case {
+    let (reference, value, detail) = match (s.compute)() {
+        Ok((r, v)) => (r, v, None),
+        Err(e) => (f64::NAN, f64::NAN, Some(e)),
+    };
+    let error_kind = if reference == 0.0 {
+        ErrorKind::Absolute
+    } else {
+        ErrorKind::Relative
+    };
+    let error = match error_kind {
+        ErrorKind::Absolute => (value - reference).abs(),
+        ErrorKind::Relative => ((value - reference) / reference).abs(),
+    };
+    let pass = value.is_finite() && reference.is_finite() && error <= s.tolerance;
+    Case {
+        name: s.name,
+        kind: s.kind,
+        quantity: s.quantity,
+        unit: s.unit,
+        reference,
+        source: s.source,
+        value,
+        error,
+        error_kind,
+        tolerance: s.tolerance,
+        pass,
+        detail,
+    }
+}
+
+fn err<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+fn tight(pos: f64, vel: f64) -> CycleOptions {
+    CycleOptions {
+        solver: SolverOptions {
+            rtol: 1e-12,
+            atol_pos: Some(pos),
+            atol_vel: Some(vel),
+            ..Default::default()
+        },
+        newton_tol: 1e-11,
+        ..CycleOptions::default()
+    }
+}
+
+fn belt(pairs: &[(&str, f64)], law: FrictionLaw) -> Result<Belt, String> {
+    let mut b = Belt {
+        friction: law,
+        ..Belt::default()
+    };
+    for (k, v) in pairs {
+        b.set(k, *v).map_err(err)?;
+    }
+    b.validate().map_err(err)?;
+    Ok(b)
+}
+
+/// The Coulomb belt's stick-slip cycle (docs/physics.md §5a′): stick from
+/// `2x_k − x_s` to `x_s`, then a harmonic slip arc about `x_k` through the
+/// angle `π + 2φ`, `φ = atan2(V/ω, x_s − x_k)`.
+fn belt_coulomb_period() -> Result<(f64, f64), String> {
+    let (m, k, n, v, mu_s, mu_k) = (1.0, 1.0e4, 100.0, 0.1, 0.4, 0.3);
+    let model = belt(
+        &[("m", m), ("k", k), ("c", 0.0), ("N", n), ("V", v)],
+        FrictionLaw::Coulomb { mu_s, mu_k },
+    )?;
+    let omega = (k / m).sqrt();
+    let (x_s, x_k) = (mu_s * n / k, mu_k * n / k);
+    let xi = x_s - x_k;
+    let phi = (v / omega).atan2(xi);
+    let reference = 2.0 * xi / v + (std::f64::consts::PI + 2.0 * phi) / omega;
+    let cyc = find_cycle(
+        &model,
+        0.0,
+        [2.0 * x_k - x_s, v],
+        &tight(1e-9 * x_s, 1e-13 * v),
+    )
+    .map_err(err)?;
+    Ok((reference, cyc.period))
+}
+
+fn thesis_law(law: &FrictionLaw) -> Result<(f64, f64, f64), String> {
+    match *law {
+        FrictionLaw::Thesis { f0, f1, uc } => Ok((f0, f1, uc)),
+        _ => Err("the model's default friction law is not the thesis law".into()),
+    }
+}
+
+fn belt_hopf_speed() -> Result<(f64, f64), String> {
+    let (c, n) = (0.2, 100.0);
+    let mut b = Belt::default();
+    b.set("c", c).map_err(err)?;
+    b.set("N", n).map_err(err)?;
+    let (f0, f1, uc) = thesis_law(&b.friction)?;
+    let reference = uc * (1.0 - c / (n * f0 * f1));
+    let cross = critical(
+        |v| {
+            let mut m = b;
+            m.set("V", v)?;
+            max_growth_rate(&m)
+        },
+        0.1,
+        0.999 * uc,
+        &CriticalOptions::default(),
+    )
+    .map_err(err)?
+    .ok_or("no change of stability found")?;
+    Ok((reference, cross.value))
+}
+
+fn disc_pad_hopf_speed() -> Result<(f64, f64), String> {
+    let brake = DiscPad::default();
+    let (f0, f1, uc) = thesis_law(&brake.friction)?;
+    let (c, n) = (brake.p.c_px, brake.p.N);
+    let reference = uc * (1.0 - c / (n * f0 * f1));
+    // Above the disc mode's own Hopf speed (c_dx = 1 kg/s: 11.7 m/s), so
+    // the pad's mode is the one that stops growing.
+    let cross = critical(
+        |v| {
+            let mut m = brake;
+            m.set("V", v)?;
+            max_growth_rate(&m)
+        },
+        0.5 * (uc + uc * (1.0 - brake.p.c_dx / (n * f0 * f1))),
+        0.999 * uc,
+        &CriticalOptions::default(),
+    )
+    .map_err(err)?
+    .ok_or("no change of stability found")?;
+    Ok((reference, cross.value))
+}
+
+fn hoffmann_mu(h: &Hoffmann) -> Result<f64, String> {
+    let cross = critical(
+        |mu| {
+            let mut m = *h;
+            m.set("mu", mu)?;
+            max_growth_rate(&m)
+        },
+        0.05,
+        0.6,
+        &CriticalOptions::default(),
+    )
+    .map_err(|e: StabilityError| e.to_string())?
+    .ok_or("no change of stability found")?;
+    Ok(cross.value)
+}
+
+fn hoffmann_undamped() -> Result<(f64, f64), String> {
+    let mut h = Hoffmann::default();
+    h.set("c1", 0.0).map_err(err)?;
+    h.set("c2", 0.0).map_err(err)?;
+    let p = &h.p;
+    let reference = ((p.k11 - p.k22).powi(2) + 4.0 * p.k12 * p.k12) / (4.0 * p.k12 * p.k3);
+    Ok((reference, hoffmann_mu(&h)?))
+}
+
+/// `det(m s² I + C s + K(μ)) = a4 s⁴ + a3 s³ + a2 s² + a1 s + a0`, with only
+/// `a0 = a00 + μ k12 k3` depending on μ; Hurwitz's `H = a3 a2 a1 − a4 a1² −
+/// a3² a0` is affine in μ and vanishes at the threshold.
+fn hoffmann_damped(c1: f64, c2: f64) -> Result<(f64, f64), String> {
+    let mut h = Hoffmann::default();
+    h.set("c1", c1).map_err(err)?;
+    h.set("c2", c2).map_err(err)?;
+    let p = &h.p;
+    let a4 = p.m * p.m;
+    let a3 = p.m * (p.c1 + p.c2);
+    let a2 = p.m * (p.k11 + p.k22) + p.c1 * p.c2;
+    let a1 = p.c1 * p.k22 + p.c2 * p.k11;
+    let a00 = p.k11 * p.k22 - p.k12 * p.k12;
+    let reference = (a3 * a2 * a1 - a4 * a1 * a1 - a3 * a3 * a00) / (a3 * a3 * p.k12 * p.k3);
+    Ok((reference, hoffmann_mu(&h)?))
+}
+
+/// Leine et al.'s belt: the period by shooting (value) against the mean
+/// spacing of the last ten stick events of a 400 s simulation (reference).
+fn leine_period() -> Result<(f64, f64), String> {
+    let law = FrictionLaw::Rational {
+        mu_s: 1.0,
+        delta: 3.0,
+    };
+    let model = belt(
+        &[("m", 1.0), ("k", 1.0), ("c", 0.0), ("N", 1.0), ("V", 0.2)],
+        law,
+    )?;
+    let opts = tight(1e-13, 1e-13);
+    let cyc = find_cycle(&model, 0.0, [0.0, 0.0], &opts).map_err(err)?;
+    let mut log = EventLog::<2>::default();
+    simulate(&model, 0.0, [0.0, 0.0], 400.0, 1.0, opts.solver, &mut log).map_err(err)?;
+    let sticks: Vec<f64> = log
+        .events
+        .iter()
+        .filter(|e| e.kind == EventKind::Stick)
+        .map(|e| e.t)
+        .collect();
+    let n = sticks.len();
+    if n <= 20 {
+        return Err(format!("{n} stick events in 400 s: no settled stick-slip"));
+    }
+    Ok(((sticks[n - 1] - sticks[n - 11]) / 10.0, cyc.period))
+}
