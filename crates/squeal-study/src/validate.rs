@@ -151,6 +151,18 @@ pub fn specs() -> Vec<Spec> {
             compute: || hoffmann_damped(0.1, 1.0),
         },
         Spec {
+            name: "nastran-punch-frequencies",
+            kind: Kind::Published,
+            quantity: "natural frequencies of a free-free bar read from MSC Nastran 2013's own \
+                       DMIG punch (KAAX, MAAX; the worst of its 8 elastic modes)",
+            unit: "Hz",
+            source: "MSC Nastran 2013 SOL 103's f06 eigenvalue table (7 digits) of the same \
+                     model: ExportNastranKM (MIT licence), crates/squeal/tests/data/\
+                     msc-nastran-2013",
+            tolerance: 5.01e-7,
+            compute: nastran_punch_frequencies,
+        },
+        Spec {
             name: "leine-rational-period",
             kind: Kind::Independent,
             quantity: "stick-slip period, belt with μ = 1/(1 + 3|v|), m = k = N = 1, V = 0.2 \
@@ -387,4 +399,70 @@ fn leine_period() -> Result<(f64, f64), String> {
         return Err(format!("{n} stick events in 400 s: no settled stick-slip"));
     }
     Ok(((sticks[n - 1] - sticks[n - 11]) / 10.0, cyc.period))
+}
+
+/// The punch file MSC Nastran 2013 wrote (SOL 103, `PARAM,EXTOUT,DMIGPCH`),
+/// embedded so that an installed binary validates without the sources.
+const NASTRAN_PUNCH: &str = include_str!("../../squeal/tests/data/msc-nastran-2013/test_case.pch");
+
+/// The 8 elastic natural frequencies (Hz) in Nastran's own f06 for that
+/// model (its two rigid-body modes left out).
+const NASTRAN_F06_HZ: [f64; 8] = [
+    2.114057e+01,
+    2.135569e+01,
+    1.287332e+02,
+    1.297476e+02,
+    4.371801e+02,
+    4.382013e+02,
+    1.258988e+03,
+    1.259566e+03,
+];
+
+/// `(Nastran's, squeal's)` frequency of the elastic mode where they differ
+/// most (relatively): `K φ = ω² M φ` of the punch's `KAAX` and `MAAX`,
+/// their dofs matched by name, solved as `stability::projected` solves
+/// undamped modes.
+fn nastran_punch_frequencies() -> Result<(f64, f64), String> {
+    use squeal_core::stability::projected::{undamped_basis, Basis, SecondOrder};
+    let k = squeal_core::dmig::parse_named(NASTRAN_PUNCH, "KAAX")?;
+    let m = squeal_core::dmig::parse_named(NASTRAN_PUNCH, "MAAX")?;
+    let labels = k.labels.clone().ok_or("KAAX has no dof names")?;
+    let n = labels.len();
+    let index = |name: &str| labels.iter().position(|l| l == name);
+    let dense =
+        |a: &squeal_core::labelled::LabelledMatrix| -> Result<nalgebra::DMatrix<f64>, String> {
+            let names = a.labels.as_ref().ok_or("a matrix without dof names")?;
+            let mut d = nalgebra::DMatrix::zeros(n, n);
+            for &(i, j, v) in &a.triplets.entries {
+                let (Some(r), Some(c)) = (index(&names[i]), index(&names[j])) else {
+                    return Err(format!("dof {} or {} is not in KAAX", names[i], names[j]));
+                };
+                d[(r, c)] += v;
+            }
+            Ok(d)
+        };
+    let sys = SecondOrder {
+        m: dense(&m)?,
+        k: dense(&k)?,
+        c: nalgebra::DMatrix::zeros(n, n),
+    };
+    let b = undamped_basis(&sys, Basis::Modes(n)).map_err(|e| e.to_string())?;
+    let hz: Vec<f64> = b
+        .omega2
+        .iter()
+        .map(|w2| w2.max(0.0).sqrt() / std::f64::consts::TAU)
+        .collect();
+    if hz.len() != NASTRAN_F06_HZ.len() + 2 {
+        return Err(format!("{} modes, expected 10", hz.len()));
+    }
+    hz[2..]
+        .iter()
+        .zip(NASTRAN_F06_HZ)
+        .map(|(&v, r)| (r, v))
+        .max_by(|a, b| {
+            ((a.1 - a.0) / a.0)
+                .abs()
+                .total_cmp(&((b.1 - b.0) / b.0).abs())
+        })
+        .ok_or_else(|| "no modes".into())
 }

@@ -49,6 +49,7 @@ fn validate_json_every_case_passes() {
         "hoffmann-mu-undamped",
         "hoffmann-mu-damped",
         "leine-rational-period",
+        "nastran-punch-frequencies",
     ] {
         assert!(names.contains(want), "{want} missing: {names:?}");
     }
