@@ -308,22 +308,21 @@ pub fn draw(
                     f >= f_lo && f <= f_hi && (!plot.log_f || f > 0.0)
                 })
                 .collect();
+            // The squealing velocity's title carries the squeal instead of
+            // the window's name (the other panels say it), so that it fits.
+            let window = if squeal.is_some() && Some(c.signal.as_str()) == squeal_velocity {
+                String::new()
+            } else {
+                format!("{} window", c.spectrum.window.name())
+            };
+            let words = match (velocity_words(&c.signal), window.is_empty()) {
+                (Some(w), false) => format!(" ({w}, {window})"),
+                (Some(w), true) => format!(" ({w})"),
+                (None, false) => format!(" ({window})"),
+                (None, true) => String::new(),
+            };
             Spec {
-                title: marked(
-                    &c.signal,
-                    match velocity_words(&c.signal) {
-                        Some(w) => format!(
-                            "{what} of {} ({w}, {} window)",
-                            c.signal,
-                            c.spectrum.window.name()
-                        ),
-                        None => format!(
-                            "{what} of {} ({} window)",
-                            c.signal,
-                            c.spectrum.window.name()
-                        ),
-                    },
-                ),
+                title: marked(&c.signal, format!("{what} of {}{words}", c.signal)),
                 y_label: if c.spectrum.scaling == Scaling::Amplitude {
                     "amplitude (dB re 1 m/s)"
                 } else {
