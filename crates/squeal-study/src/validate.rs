@@ -163,6 +163,19 @@ pub fn specs() -> Vec<Spec> {
             compute: nastran_punch_frequencies,
         },
         Spec {
+            name: "fe-brake-every-format",
+            kind: Kind::Independent,
+            quantity: "natural frequencies of the 124-dof two-pad FE brake read from Matrix \
+                       Market, Nastran DMIG, Abaqus and Harwell–Boeing (the worst mode above \
+                       1 Hz of the three against Matrix Market)",
+            unit: "Hz",
+            source: "the same model written by four independent writers (SciPy's Matrix \
+                     Market, make_brake.py's DMIG, Abaqus and RSA + ANSYS mapping writers), \
+                     examples/fe-brake/two-pad",
+            tolerance: 1e-9,
+            compute: fe_formats_agree,
+        },
+        Spec {
             name: "leine-rational-period",
             kind: Kind::Independent,
             quantity: "stick-slip period, belt with μ = 1/(1 + 3|v|), m = k = N = 1, V = 0.2 \
@@ -418,40 +431,55 @@ const NASTRAN_F06_HZ: [f64; 8] = [
     1.259566e+03,
 ];
 
-/// `(Nastran's, squeal's)` frequency of the elastic mode where they differ
-/// most (relatively): `K φ = ω² M φ` of the punch's `KAAX` and `MAAX`,
-/// their dofs matched by name, solved as `stability::projected` solves
-/// undamped modes.
-fn nastran_punch_frequencies() -> Result<(f64, f64), String> {
+/// The undamped natural frequencies (Hz, ascending) of `K φ = ω² M φ`,
+/// `M`'s dofs matched to `K`'s by name (numbered dofs as they are), solved
+/// as `stability::projected` solves undamped modes.
+fn natural_frequencies(
+    k: &squeal_core::labelled::LabelledMatrix,
+    m: &squeal_core::labelled::LabelledMatrix,
+) -> Result<Vec<f64>, String> {
     use squeal_core::stability::projected::{undamped_basis, Basis, SecondOrder};
-    let k = squeal_core::dmig::parse_named(NASTRAN_PUNCH, "KAAX")?;
-    let m = squeal_core::dmig::parse_named(NASTRAN_PUNCH, "MAAX")?;
-    let labels = k.labels.clone().ok_or("KAAX has no dof names")?;
-    let n = labels.len();
-    let index = |name: &str| labels.iter().position(|l| l == name);
+    let n = k.triplets.rows;
+    if m.triplets.rows != n {
+        return Err(format!("K has {n} dofs, M {}", m.triplets.rows));
+    }
+    // Row/column of `a`'s index `i` in K's numbering.
+    let place = |a: &squeal_core::labelled::LabelledMatrix, i: usize| -> Result<usize, String> {
+        match (&k.labels, &a.labels) {
+            (Some(kl), Some(al)) => kl
+                .iter()
+                .position(|l| *l == al[i])
+                .ok_or_else(|| format!("dof {} is not in K", al[i])),
+            (None, None) => Ok(i),
+            _ => Err("one matrix names its dofs, the other numbers them".into()),
+        }
+    };
     let dense =
         |a: &squeal_core::labelled::LabelledMatrix| -> Result<nalgebra::DMatrix<f64>, String> {
-            let names = a.labels.as_ref().ok_or("a matrix without dof names")?;
             let mut d = nalgebra::DMatrix::zeros(n, n);
             for &(i, j, v) in &a.triplets.entries {
-                let (Some(r), Some(c)) = (index(&names[i]), index(&names[j])) else {
-                    return Err(format!("dof {} or {} is not in KAAX", names[i], names[j]));
-                };
-                d[(r, c)] += v;
+                d[(place(a, i)?, place(a, j)?)] += v;
             }
             Ok(d)
         };
     let sys = SecondOrder {
-        m: dense(&m)?,
-        k: dense(&k)?,
+        m: dense(m)?,
+        k: dense(k)?,
         c: nalgebra::DMatrix::zeros(n, n),
     };
     let b = undamped_basis(&sys, Basis::Modes(n)).map_err(|e| e.to_string())?;
-    let hz: Vec<f64> = b
-        .omega2
+    Ok(b.omega2
         .iter()
         .map(|w2| w2.max(0.0).sqrt() / std::f64::consts::TAU)
-        .collect();
+        .collect())
+}
+
+/// `(Nastran's, squeal's)` frequency of the elastic mode where they differ
+/// most (relatively), from the punch's `KAAX` and `MAAX`.
+fn nastran_punch_frequencies() -> Result<(f64, f64), String> {
+    let k = squeal_core::dmig::parse_named(NASTRAN_PUNCH, "KAAX")?;
+    let m = squeal_core::dmig::parse_named(NASTRAN_PUNCH, "MAAX")?;
+    let hz = natural_frequencies(&k, &m)?;
     if hz.len() != NASTRAN_F06_HZ.len() + 2 {
         return Err(format!("{} modes, expected 10", hz.len()));
     }
@@ -465,4 +493,76 @@ fn nastran_punch_frequencies() -> Result<(f64, f64), String> {
                 .total_cmp(&((b.1 - b.0) / b.0).abs())
         })
         .ok_or_else(|| "no modes".into())
+}
+
+/// The two-pad FE brake of `examples/fe-brake/two-pad` (124 dofs) as four
+/// independent writers wrote it: SciPy (Matrix Market), a Nastran DMIG
+/// punch, Abaqus `*MATRIX OUTPUT` and Harwell–Boeing RSA with ANSYS's
+/// mapping file (`make_brake.py`), embedded.
+mod fe_brake {
+    macro_rules! file {
+        ($f:literal) => {
+            include_str!(concat!("../../../examples/fe-brake/two-pad/", $f))
+        };
+    }
+    pub const MM_K: &str = file!("K.mtx");
+    pub const MM_M: &str = file!("M.mtx");
+    pub const PUNCH: &str = file!("brake.pch");
+    pub const ABAQUS_K: &str = file!("brake_STIF1.mtx");
+    pub const ABAQUS_M: &str = file!("brake_MASS1.mtx");
+    pub const HB_K: &str = file!("brake_K.matrix");
+    pub const HB_K_MAP: &str = file!("brake_K.mapping");
+    pub const HB_M: &str = file!("brake_M.matrix");
+    pub const HB_M_MAP: &str = file!("brake_M.mapping");
+}
+
+/// `(Matrix Market's, another format's)` natural frequency where the
+/// formats differ most (relatively, over the modes above 1 Hz): the same
+/// model read from every format squeal reads gives the same structure.
+fn fe_formats_agree() -> Result<(f64, f64), String> {
+    use squeal_core::labelled::LabelledMatrix;
+    use squeal_core::{abaqus, dmig, harwell_boeing};
+    let mm = |text: &str| -> Result<LabelledMatrix, String> {
+        Ok(LabelledMatrix {
+            name: String::new(),
+            format: "matrix-market",
+            labels: None,
+            triplets: squeal_core::matrix_market::parse(text)?,
+            symmetric: false,
+        })
+    };
+    let reference = natural_frequencies(&mm(fe_brake::MM_K)?, &mm(fe_brake::MM_M)?)?;
+    let others = [
+        natural_frequencies(
+            &dmig::parse_named(fe_brake::PUNCH, "KAAX")?,
+            &dmig::parse_named(fe_brake::PUNCH, "MAAX")?,
+        )?,
+        natural_frequencies(
+            &abaqus::parse(fe_brake::ABAQUS_K)?,
+            &abaqus::parse(fe_brake::ABAQUS_M)?,
+        )?,
+        natural_frequencies(
+            &harwell_boeing::parse(fe_brake::HB_K, Some(fe_brake::HB_K_MAP))?,
+            &harwell_boeing::parse(fe_brake::HB_M, Some(fe_brake::HB_M_MAP))?,
+        )?,
+    ];
+    let mut worst: Option<(f64, f64)> = None;
+    for hz in &others {
+        if hz.len() != reference.len() {
+            return Err(format!(
+                "{} modes against Matrix Market's {}",
+                hz.len(),
+                reference.len()
+            ));
+        }
+        for (&r, &v) in reference.iter().zip(hz) {
+            if r > 1.0 {
+                let e = ((v - r) / r).abs();
+                if worst.is_none_or(|(wr, wv)| e > ((wv - wr) / wr).abs()) {
+                    worst = Some((r, v));
+                }
+            }
+        }
+    }
+    worst.ok_or_else(|| "no mode above 1 Hz".into())
 }

@@ -50,6 +50,7 @@ fn validate_json_every_case_passes() {
         "hoffmann-mu-damped",
         "leine-rational-period",
         "nastran-punch-frequencies",
+        "fe-brake-every-format",
     ] {
         assert!(names.contains(want), "{want} missing: {names:?}");
     }
