@@ -217,7 +217,11 @@ def test_scenarios_lists_builtins():
 def _interrupt_after(delay):
     script = textwrap.dedent(
         """
-        import sys, time, squeal
+        import signal, sys, time, squeal
+        # A parent started in the background of a non-interactive shell
+        # passes SIGINT down ignored, and Python then installs no
+        # KeyboardInterrupt handler: restore it, as a terminal would have it.
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         print("start", flush=True)
         t0 = time.monotonic()
         try:
