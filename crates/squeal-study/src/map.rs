@@ -231,8 +231,8 @@ struct Watch {
     decided: Option<&'static str>,
     /// The scenario's validity bound (m): a position beyond it ends the run `out-of-range`.
     validity: f64,
-    /// The radiating surfaces' state indices (their velocities).
-    surfaces: Vec<usize>,
+    /// The radiating surfaces: their velocities' state indices and areas (m²).
+    surfaces: Vec<(usize, f64)>,
     /// Their velocities over the current window, interleaved (capacity
     /// reserved for a whole window: no allocation while running).
     current: Vec<f64>,
@@ -254,7 +254,7 @@ impl<const N: usize> Sink<N> for Watch {
         self.sum2 += z[self.v_idx] * z[self.v_idx];
         self.count += 1;
         if self.current.len() + self.surfaces.len() <= self.current.capacity() {
-            for &i in &self.surfaces {
+            for &(i, _) in &self.surfaces {
                 self.current.push(z[i]);
             }
         }
@@ -306,11 +306,16 @@ fn watch_for<M: System<N>, const N: usize>(
     let v_idx = *idx.first().ok_or("no tangential velocity")?;
     let z0 = crate::run::initial_of(model, sc).map_err(|e| e.to_string())?;
     let window = sc.duration / 50.0;
-    let surfaces: Vec<usize> = sc
+    let surfaces: Vec<(usize, f64)> = sc
         .radiation
         .areas
         .iter()
-        .filter_map(|(dof, _)| names.iter().position(|n| n == dof).map(|i| i + N / 2))
+        .filter_map(|(dof, a)| {
+            names[..N / 2]
+                .iter()
+                .position(|n| n == dof)
+                .map(|i| (i + N / 2, *a))
+        })
         .collect();
     // A window's samples, and a few more for the sample that closes it.
     let room = ((window * sc.sample_rate).ceil() as usize + 4) * surfaces.len();
@@ -346,12 +351,11 @@ fn last_window_dba(w: &Watch, sc: &Scenario) -> f64 {
     let columns: Vec<Vec<f64>> = (0..k)
         .map(|j| w.last.iter().skip(j).step_by(k).copied().collect())
         .collect();
-    let surfaces: Vec<(f64, &[f64])> = sc
-        .radiation
-        .areas
+    let surfaces: Vec<(f64, &[f64])> = w
+        .surfaces
         .iter()
         .zip(&columns)
-        .map(|((_, a), c)| (*a, c.as_slice()))
+        .map(|(&(_, a), c)| (a, c.as_slice()))
         .collect();
     let l = sc.radiation.listener().levels(&surfaces, sc.sample_rate);
     if l.spl_dba.is_finite() {

@@ -206,13 +206,13 @@ pub fn shown_signals<'a>(
             }
         }
     }
-    let mut rest: Vec<&ChannelSpectrum> = all
+    let mut rest: Vec<(f64, &ChannelSpectrum)> = all
         .iter()
-        .copied()
         .filter(|c| !order.iter().any(|o| o.signal == c.signal))
+        .map(|c| (rms(&c.signal), *c))
         .collect();
-    rest.sort_by(|a, b| rms(&b.signal).total_cmp(&rms(&a.signal)));
-    order.extend(rest);
+    rest.sort_by(|a, b| b.0.total_cmp(&a.0));
+    order.extend(rest.into_iter().map(|(_, c)| c));
     order.truncate(MAX_SHOWN_SIGNALS);
     order
 }
