@@ -9,7 +9,7 @@
 
 use crate::error::Progress;
 use serde::Serialize;
-use squeal_core::cycle::{find_cycle, CycleOptions};
+use squeal_core::cycle::{find_cycle, return_map_multipliers, section_returns, CycleOptions};
 use squeal_core::model::hoffmann::Hoffmann;
 use squeal_core::sink::EventLog;
 use squeal_core::stability::{critical, max_growth_rate, CriticalOptions, StabilityError};
@@ -186,6 +186,43 @@ pub fn specs() -> Vec<Spec> {
                      event-driven simulation",
             tolerance: 1e-6,
             compute: leine_period,
+        },
+        Spec {
+            name: "disc-pad-cycle-period",
+            kind: Kind::Independent,
+            quantity: "period of the default disc–pad's limit cycle (the pad's reversal cycle, \
+                       Newton shooting) against the mean return time to its section over 2000 \
+                       returns of a simulation started on the cycle",
+            unit: "s",
+            source: "the event-driven simulation's returns to the Poincaré section (upward \
+                     crossings located on the dense output), squeal_core::cycle::section_returns",
+            tolerance: 1e-9,
+            compute: || disc_pad_cycle().map(|c| (c.returns_period, c.period)),
+        },
+        Spec {
+            name: "disc-pad-cycle-multipliers",
+            kind: Kind::Independent,
+            quantity: "Floquet multipliers of the default disc–pad's limit cycle (variational \
+                       equations, saltation matrices at its reversals): the largest distance \
+                       |μ − μ_ref| of the 7 non-trivial ones from the nearest eigenvalue of the \
+                       simulated return map",
+            unit: "1",
+            source: "eigenvalues of the Poincaré map's Jacobian by central differences of \
+                     simulated returns (h = 1e-6 of the state scales, rtol 1e-12), no variational \
+                     equation: squeal_core::cycle::return_map_multipliers",
+            tolerance: 1e-6,
+            compute: || disc_pad_cycle().map(|c| (0.0, c.worst_distance)),
+        },
+        Spec {
+            name: "disc-pad-cycle-decay-rate",
+            kind: Kind::Independent,
+            quantity: "decay rate ln|μ₁|/T of the default disc–pad cycle's slowest perturbation \
+                       (its largest non-trivial multiplier, 1 − |μ₁| ≈ 2e-5)",
+            unit: "1/s",
+            source: "the largest eigenvalue of the simulated return map's Jacobian, as in \
+                     disc-pad-cycle-multipliers",
+            tolerance: 1e-3,
+            compute: || disc_pad_cycle().map(|c| (c.decay_ref, c.decay)),
         },
     ]
 }
@@ -412,6 +449,70 @@ fn leine_period() -> Result<(f64, f64), String> {
         return Err(format!("{n} stick events in 400 s: no settled stick-slip"));
     }
     Ok(((sticks[n - 1] - sticks[n - 11]) / 10.0, cyc.period))
+}
+
+/// The default disc–pad's cycle, computed once for the three cases that
+/// compare it.
+struct DiscPadCycle {
+    /// Shooting's period (s).
+    period: f64,
+    /// Mean return time of a 2000-return simulation from the cycle (s).
+    returns_period: f64,
+    /// Largest distance of a non-trivial multiplier from the nearest
+    /// eigenvalue of the simulated return map.
+    worst_distance: f64,
+    /// `ln|μ₁|/T` of the shooting's largest non-trivial multiplier (1/s).
+    decay: f64,
+    /// The same of the return map's largest eigenvalue (1/s).
+    decay_ref: f64,
+}
+
+/// Returns counted for the mean return time.
+const CYCLE_RETURNS: usize = 2000;
+
+fn disc_pad_cycle() -> Result<&'static DiscPadCycle, String> {
+    static CELL: std::sync::OnceLock<Result<DiscPadCycle, String>> = std::sync::OnceLock::new();
+    CELL.get_or_init(|| {
+        let brake = DiscPad::default();
+        let cyc = find_cycle(&brake, 0.0, [0.0; 8], &CycleOptions::default()).map_err(err)?;
+        let solver = SolverOptions {
+            rtol: 1e-12,
+            atol_pos: Some(1e-20),
+            atol_vel: Some(1e-15),
+            ..Default::default()
+        };
+        let t_end = (CYCLE_RETURNS as f64 + 0.5) * cyc.period;
+        let returns =
+            section_returns(&brake, 0.0, cyc.z0, t_end, cyc.section, solver).map_err(err)?;
+        if returns.len() != CYCLE_RETURNS {
+            return Err(format!(
+                "{} returns to the section in {CYCLE_RETURNS}.5 periods, not {CYCLE_RETURNS}",
+                returns.len()
+            ));
+        }
+        let returns_period = returns[CYCLE_RETURNS - 1].0 / CYCLE_RETURNS as f64;
+        let map = return_map_multipliers(&brake, &cyc, 1e-6, solver).map_err(err)?;
+        let worst_distance = cyc
+            .multipliers
+            .iter()
+            .filter(|m| !m.trivial)
+            .map(|a| {
+                map.iter()
+                    .map(|b| (a.re - b.re).hypot(a.im - b.im))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(0.0, f64::max);
+        let largest = map.first().ok_or("the return map has no eigenvalue")?;
+        Ok(DiscPadCycle {
+            period: cyc.period,
+            returns_period,
+            worst_distance,
+            decay: cyc.max_multiplier.ln() / cyc.period,
+            decay_ref: largest.abs().ln() / cyc.period,
+        })
+    })
+    .as_ref()
+    .map_err(Clone::clone)
 }
 
 /// The punch file MSC Nastran 2013 wrote (SOL 103, `PARAM,EXTOUT,DMIGPCH`),

@@ -44,7 +44,7 @@ pub fn run(a: ValidateArgs) -> Result<(), RunError> {
         );
     } else {
         crate::outln!(
-            "{:<28} {:<11} {:>14} {:>14} {:>9} {:>9}  pass",
+            "{:<28} {:<11} {:>16} {:>16} {:>9} {:>9}  pass",
             "name",
             "kind",
             "reference",
@@ -58,11 +58,11 @@ pub fn run(a: ValidateArgs) -> Result<(), RunError> {
                 .and_then(|v| v.as_str().map(str::to_string))
                 .unwrap_or_default();
             crate::outln!(
-                "{:<28} {:<11} {:>14.10} {:>14.10} {:>9.2e} {:>9.0e}  {}",
+                "{:<28} {:<11} {:>16} {:>16} {:>9.2e} {:>9.0e}  {}",
                 c.name,
                 kind,
-                c.reference,
-                c.value,
+                number(c.reference),
+                number(c.value),
                 c.error,
                 c.tolerance,
                 if c.pass { "pass" } else { "FAIL" }
@@ -109,4 +109,14 @@ fn wrap(text: &str) -> Vec<String> {
         lines.push(line);
     }
     lines
+}
+
+/// A case's number to 10 significant digits: fixed-point between 0.01 and
+/// 10⁶, scientific outside (a period of 48 µs keeps its digits).
+fn number(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-2..1e6).contains(&x.abs()) {
+        format!("{x:.9e}")
+    } else {
+        format!("{x:.10}")
+    }
 }
