@@ -6,6 +6,7 @@ mod branch;
 mod breakaway;
 mod budget;
 mod contact;
+mod craig_bampton;
 mod cycle;
 mod engine;
 mod ensemble;

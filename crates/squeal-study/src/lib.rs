@@ -24,6 +24,7 @@ pub mod matrix_file;
 pub mod memory;
 pub mod model;
 pub mod radiation;
+pub mod reduce;
 pub mod reproduce;
 pub mod run;
 pub mod scenario;

@@ -182,7 +182,7 @@ impl AnyModel {
     pub fn check_simulable(&self) -> Result<(), String> {
         match self {
             AnyModel::Lumped(l) if l.dof_count() > MAX_SIM_DOFS => Err(format!(
-                "this lumped model has {} dofs: simulation supports up to {MAX_SIM_DOFS} dofs (stability, map, critical and sweep work for any size)",
+                "this lumped model has {} dofs: simulation supports up to {MAX_SIM_DOFS} dofs (stability, map, critical and sweep work for any size; `squeal reduce` makes a Craig–Bampton model of it with the contact dofs kept, which simulates)",
                 l.dof_count()
             )),
             _ => Ok(()),

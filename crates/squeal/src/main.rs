@@ -42,6 +42,8 @@ enum Command {
     Stability(commands::stability::StabilityArgs),
     /// What a scenario's files hold: matrices (format, size, symmetry), dofs, natural frequencies, contacts.
     Inspect(commands::inspect::InspectArgs),
+    /// Reduce a lumped (FE) model by Craig–Bampton: contact dofs kept physical, fixed-interface modes to modal.cutoff_hz; written as a scenario.
+    Reduce(commands::reduce::ReduceArgs),
     /// Stability map over a grid of two parameters (linear, or --transient by simulation).
     Map(commands::map::MapArgs),
     /// Gather the shards of a map (`map … --shard K/N`) into the map the unsharded run writes.
@@ -141,6 +143,7 @@ fn dispatch(command: Command) -> Result<(), RunError> {
         Command::Reproduce(a) => commands::reproduce::run(a),
         Command::Stability(a) => commands::stability::run(a),
         Command::Inspect(a) => commands::inspect::run(a),
+        Command::Reduce(a) => commands::reduce::run(a),
         Command::Map(a) => commands::map::run(a),
         Command::Merge(a) => commands::merge::run(a),
         Command::Slurm { what } => commands::slurm::run(what),

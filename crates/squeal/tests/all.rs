@@ -12,6 +12,7 @@ mod levers_cli;
 mod lumped_cli;
 mod params_cli;
 mod radiation_cli;
+mod reduce_cli;
 mod reliability;
 mod reliability_inputs;
 mod reliability_limits;

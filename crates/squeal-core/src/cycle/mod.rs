@@ -922,16 +922,7 @@ fn multipliers_of(
             proj[(i, k)] -= f[i] / f[k];
         }
     }
-    let poincare = proj * m;
-    let ev = poincare.complex_eigenvalues();
-    let mut list: Vec<Multiplier> = ev
-        .iter()
-        .map(|c| Multiplier {
-            re: c.re,
-            im: c.im,
-            trivial: false,
-        })
-        .collect();
+    let mut list = eigen_multipliers(&(proj * m));
     // The section's own direction: the eigenvalue nearest zero stands for the flow.
     let zero = (0..n)
         .min_by(|&a, &b| list[a].abs().total_cmp(&list[b].abs()))
@@ -948,6 +939,18 @@ fn multipliers_of(
         .fold(0.0, f64::max);
     sort_multipliers(&mut list);
     (list, max)
+}
+
+/// The eigenvalues of `a` as multipliers (none marked trivial).
+fn eigen_multipliers(a: &DMatrix<f64>) -> Vec<Multiplier> {
+    a.complex_eigenvalues()
+        .iter()
+        .map(|c| Multiplier {
+            re: c.re,
+            im: c.im,
+            trivial: false,
+        })
+        .collect()
 }
 
 /// Sort by modulus descending, then real part, then imaginary part.
@@ -1122,15 +1125,7 @@ pub fn return_map_multipliers<S: System<N> + ?Sized, const N: usize>(
             "the return map's Jacobian is not finite".into(),
         ));
     }
-    let mut list: Vec<Multiplier> = jac
-        .complex_eigenvalues()
-        .iter()
-        .map(|c| Multiplier {
-            re: c.re,
-            im: c.im,
-            trivial: false,
-        })
-        .collect();
+    let mut list = eigen_multipliers(&jac);
     sort_multipliers(&mut list);
     Ok(list)
 }

@@ -955,6 +955,17 @@ impl Lumped {
     pub fn dofs(&self) -> &[String] {
         &self.dofs
     }
+    /// `M`, `K`, `C` as read from the model's files, on [`Lumped::dofs`]
+    /// (after the static condensation of massless dofs), before their
+    /// scale factors (`matrices.M_scale`, …) and without `[masses]`,
+    /// springs or contacts; `None` where the file has no such matrix.
+    pub fn file_matrices(&self) -> [Option<&Sparse>; 3] {
+        [
+            self.matrix_base[0].as_ref(),
+            self.matrix_base[1].as_ref(),
+            self.matrix_base[2].as_ref(),
+        ]
+    }
     /// State names: the dofs, then `v<dof>`.
     pub fn state_names(&self) -> &[String] {
         &self.states

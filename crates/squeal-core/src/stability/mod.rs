@@ -41,6 +41,7 @@
 //! the reasons it is hand-written).
 
 pub mod coupling;
+pub mod craig_bampton;
 pub mod eigen;
 pub mod lumped;
 pub mod modal;

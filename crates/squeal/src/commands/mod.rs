@@ -8,6 +8,7 @@ pub mod listen;
 pub mod map;
 pub mod merge;
 pub mod plot;
+pub mod reduce;
 pub mod reproduce;
 pub mod scenario;
 pub mod simulate;
