@@ -234,6 +234,7 @@ fn main() {
             &names,
             None,
             squeal_core::stability::projected::ModalOptions::default().basis(),
+            squeal_core::stability::projected::BasisKind::Modes,
         )
         .unwrap();
         let shapes: usize = an.eigen.iter().map(|e| mode_shape(e).len()).sum();

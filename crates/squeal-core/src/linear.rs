@@ -35,6 +35,43 @@ pub struct ModalOptions {
     pub modes: usize,
     /// Keep every undamped mode up to this frequency (Hz).
     pub cutoff_hz: f64,
+    /// Free-interface modes with static correction, or Craig–Bampton
+    /// (key `modal.basis`).
+    #[serde(rename = "basis")]
+    pub kind: BasisKind,
+}
+
+/// What spans a projection basis (key `modal.basis`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BasisKind {
+    /// The undamped (free-interface) modes of the whole model, with the
+    /// static correction at the contact dofs (`"modes"`).
+    #[default]
+    Modes,
+    /// The contact dofs kept physical with their constraint modes, plus the
+    /// fixed-interface modes of the rest (`"craig-bampton"`).
+    CraigBampton,
+}
+
+impl BasisKind {
+    /// Every kind's key value.
+    pub const NAMES: [&'static str; 2] = ["modes", "craig-bampton"];
+    /// The key value (`"modes"`, `"craig-bampton"`).
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            BasisKind::Modes => "modes",
+            BasisKind::CraigBampton => "craig-bampton",
+        }
+    }
+    /// From the key value.
+    pub fn parse(s: &str) -> Option<BasisKind> {
+        match s {
+            "modes" => Some(BasisKind::Modes),
+            "craig-bampton" => Some(BasisKind::CraigBampton),
+            _ => None,
+        }
+    }
 }
 
 impl Default for ModalOptions {
@@ -43,6 +80,7 @@ impl Default for ModalOptions {
             dense_max_dofs: DEFAULT_DENSE_MAX_DOFS,
             modes: 0,
             cutoff_hz: CUTOFF_FACTOR * BAND_HZ,
+            kind: BasisKind::Modes,
         }
     }
 }

@@ -218,7 +218,7 @@ fn projected_eigenvalues_equal_the_analysis() {
     // And the core function on the second-order system directly.
     let z = l.equilibrium_dyn().unwrap();
     let sys: SecondOrder = l.second_order_dyn(&z);
-    let (ev2, _) = projected_eigenvalues(&sys, l.modal.basis()).unwrap();
+    let (ev2, _) = projected_eigenvalues(&sys, l.modal.basis(), l.modal.kind).unwrap();
     assert_eq!(ev2, ev);
     let an2 = analyse_projected(
         &sys,
@@ -226,6 +226,7 @@ fn projected_eigenvalues_equal_the_analysis() {
         l.state_names(),
         None,
         Basis::CutoffHz(l.modal.cutoff_hz),
+        l.modal.kind,
     )
     .unwrap();
     assert_eq!(an2.max_growth_rate, an.max_growth_rate);

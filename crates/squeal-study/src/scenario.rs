@@ -499,6 +499,7 @@ impl Scenario {
             k if self.atol_index(k).is_some() => "solver",
             k if self.offset_index(k).is_some() => "offsets",
             k if k.starts_with("radiation.") => "radiation",
+            "modal.basis" if matches!(self.model, AnyModel::Lumped(_)) => "params",
             k if self.model.get(k).is_some() => "params",
             "model" => {
                 return err("model cannot be changed by --set: choose a scenario of that model")
@@ -605,6 +606,18 @@ impl Scenario {
                 self.initial = Initial::parse(&t).ok_or_else(|| {
                     InputError(format!("initial = '{t}': expected rest or equilibrium"))
                 })?;
+            }
+            ("params", "modal.basis") => {
+                let t = text(value)?;
+                let kind = squeal_core::linear::BasisKind::parse(&t).ok_or_else(|| {
+                    InputError(format!(
+                        "modal.basis = '{t}': expected {}",
+                        squeal_core::linear::BasisKind::NAMES.join(" or ")
+                    ))
+                })?;
+                if let AnyModel::Lumped(l) = &mut self.model {
+                    l.modal.kind = kind;
+                }
             }
             ("", "contact") => {
                 let t = text(value)?;

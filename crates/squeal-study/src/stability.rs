@@ -193,7 +193,7 @@ pub fn document(sc: &crate::Scenario, an: &Analysis, levers: &Levers) -> Value {
 /// How a study of `model` (a critical value, a map: one eigen-analysis per
 /// point) computes its eigenvalues: `{"method": "dense"}`, or for a lumped
 /// model above `modal.dense_max_dofs` `{"method": "projected",
-/// "dense_max_dofs": …, "modes": …, "cutoff_hz": …}` (the basis is rebuilt
+/// "dense_max_dofs": …, "modes": …, "cutoff_hz": …, "basis": …}` (the basis is rebuilt
 /// at every point).
 pub fn modal_options_json(model: &AnyModel) -> Value {
     match model {
@@ -202,6 +202,7 @@ pub fn modal_options_json(model: &AnyModel) -> Value {
             "dense_max_dofs": l.modal.dense_max_dofs,
             "modes": l.modal.modes,
             "cutoff_hz": l.modal.cutoff_hz,
+            "basis": l.modal.kind.as_str(),
         }),
         _ => json!({ "method": "dense" }),
     }

@@ -142,3 +142,49 @@ fn what_cannot_be_reduced_is_refused() {
     assert!(e.contains("no M and K matrix files"), "{e}");
     assert!(!d.path().join("x").exists());
 }
+
+/// `modal.basis = "craig-bampton"` in the projected CEA spans the same
+/// space as `squeal reduce` (so the same unstable eigenvalue, to the
+/// solvers' round-off), says so, and its truncation table grows the
+/// fixed-interface modes; a bad value is refused naming the key.
+#[test]
+fn the_projected_analysis_takes_a_craig_bampton_basis() {
+    let d = tempfile::tempdir().unwrap();
+    let b = brake();
+    let b = b.to_str().unwrap();
+    reduce(d.path(), "r", &["modal.cutoff_hz=2100"]);
+    let path = d.path().join("r/scenario.toml");
+    let red = unstable(&json(&squeal(
+        d.path(),
+        &["stability", path.to_str().unwrap(), "--json", "--no-levers"],
+    )));
+    let sets = [
+        "--set",
+        "modal.dense_max_dofs=0",
+        "--set",
+        "modal.cutoff_hz=2100",
+        "--set",
+        "modal.basis=craig-bampton",
+    ];
+    let mut args = vec!["stability", b, "--json", "--no-levers"];
+    args.extend(sets);
+    let doc = json(&squeal(d.path(), &args));
+    assert_eq!(doc["modal"]["basis"], "craig-bampton", "{}", doc["modal"]);
+    let cb = unstable(&doc);
+    assert!(rel(cb, red) < 1e-9, "{cb:?} vs {red:?}");
+    let mut args = vec!["stability", b, "--no-levers"];
+    args.extend(sets);
+    let text = ok(&squeal(d.path(), &args));
+    assert!(
+        text.contains("Craig–Bampton basis of 124 dofs: the 7 contact dofs kept physical and 5 fixed-interface modes"),
+        "{text}"
+    );
+    let e = refused(&squeal(
+        d.path(),
+        &["stability", b, "--set", "modal.basis=free"],
+    ));
+    assert!(
+        e.contains("modal.basis = 'free': expected modes or craig-bampton"),
+        "{e}"
+    );
+}

@@ -45,7 +45,7 @@ pub fn eigenvalues_with_method(
 ) -> Result<(Vec<nalgebra::Complex<f64>>, Method), StabilityError> {
     if l.modal.projects(l.dof_count()) {
         let z = equilibrium(l)?;
-        projected::projected_eigenvalues(&l.second_order_dyn(&z), l.modal.basis())
+        projected::projected_eigenvalues(&l.second_order_dyn(&z), l.modal.basis(), l.modal.kind)
     } else {
         let (_, a) = state_matrix(l)?;
         Ok((super::modal::eigenvalues(&a)?, Method::Dense))
@@ -75,7 +75,7 @@ pub fn max_growth_rate(l: &Lumped) -> Result<(f64, f64), StabilityError> {
 pub fn truncation_table(l: &Lumped) -> Option<Result<Vec<projected::Truncation>, StabilityError>> {
     l.modal.projects(l.dof_count()).then(|| {
         let z = equilibrium(l)?;
-        projected::truncation_table(&l.second_order_dyn(&z), l.modal.basis())
+        projected::truncation_table(&l.second_order_dyn(&z), l.modal.basis(), l.modal.kind)
     })
 }
 
@@ -93,6 +93,7 @@ pub fn analyse(l: &Lumped, masses: Option<&[f64]>) -> Result<Analysis, Stability
             l.state_names(),
             masses,
             l.modal.basis(),
+            l.modal.kind,
         )
     } else {
         let (z, a) = state_matrix(l)?;

@@ -39,7 +39,7 @@ use nalgebra::{Complex, DMatrix};
 use serde::Serialize;
 
 pub use crate::linear::{
-    Basis, ModalOptions, SecondOrder, BAND_HZ, CUTOFF_FACTOR, DEFAULT_DENSE_MAX_DOFS,
+    Basis, BasisKind, ModalOptions, SecondOrder, BAND_HZ, CUTOFF_FACTOR, DEFAULT_DENSE_MAX_DOFS,
 };
 
 /// How an [`Analysis`] was computed (reported with it).
@@ -60,8 +60,12 @@ pub enum Method {
         /// Undamped frequency of the highest mode kept (Hz).
         basis_max_hz: f64,
         /// Static-correction vectors added at the contact dofs
-        /// ([`with_static_correction`]).
+        /// ([`with_static_correction`]); for a Craig–Bampton basis, the
+        /// contact dofs kept physical.
         static_vectors: usize,
+        /// What spans the basis (`modal.basis`); `modes` then counts the
+        /// fixed-interface modes of a Craig–Bampton basis.
+        basis: BasisKind,
     },
 }
 
@@ -380,7 +384,7 @@ fn reduced_state_matrix(sys: &SecondOrder, b: &UndampedBasis) -> DMatrix<f64> {
     a
 }
 
-fn method(sys: &SecondOrder, b: &UndampedBasis) -> Method {
+fn method(sys: &SecondOrder, b: &UndampedBasis, basis: BasisKind) -> Method {
     let modes = b.phi.ncols() - b.static_vectors;
     Method::Projected {
         modes,
@@ -390,6 +394,7 @@ fn method(sys: &SecondOrder, b: &UndampedBasis) -> Method {
             .map_or(0.0, |w2| w2.max(0.0).sqrt())
             / (2.0 * std::f64::consts::PI),
         static_vectors: b.static_vectors,
+        basis,
     }
 }
 
@@ -399,6 +404,60 @@ fn method(sys: &SecondOrder, b: &UndampedBasis) -> Method {
 pub fn corrected_basis(sys: &SecondOrder, basis: Basis) -> Result<UndampedBasis, StabilityError> {
     let b = undamped_basis(sys, basis)?;
     with_static_correction(sys, b, &coupling_dofs(sys))
+}
+
+/// The projection basis of `kind`: [`corrected_basis`], or
+/// [`craig_bampton_basis`].
+pub fn basis_of(
+    sys: &SecondOrder,
+    basis: Basis,
+    kind: BasisKind,
+) -> Result<UndampedBasis, StabilityError> {
+    match kind {
+        BasisKind::Modes => corrected_basis(sys, basis),
+        BasisKind::CraigBampton => craig_bampton_basis(sys, basis),
+    }
+}
+
+/// The Craig–Bampton basis ([`super::craig_bampton`]) with the dofs where
+/// the coupling is non-symmetric ([`coupling_dofs`]: the friction contacts)
+/// kept physical and the fixed-interface modes `basis` asks for, made
+/// `M`-orthonormal by Rayleigh–Ritz in its span (`Tᵀ K_s T w = ω² Tᵀ M T w`,
+/// `Φ = T W`), so that the projected problem is the one of
+/// [`analyse_projected`]: the span, and so the eigenvalues, are those of
+/// `T`. `omega2` lists the fixed-interface modes' `ω²`, then the
+/// `static_vectors` (= boundary dofs) largest Ritz values.
+pub fn craig_bampton_basis(
+    sys: &SecondOrder,
+    basis: Basis,
+) -> Result<UndampedBasis, StabilityError> {
+    let n = check(sys)?;
+    let boundary = coupling_dofs(sys);
+    let cb = super::craig_bampton::craig_bampton(&sys.m, &sys.k, &boundary, basis)?;
+    let r = cb.t.ncols();
+    if r == 0 {
+        return Err(StabilityError::BadInput(
+            "Craig–Bampton basis: no contact dof and no fixed-interface mode below modal.cutoff_hz"
+                .into(),
+        ));
+    }
+    let ks = DMatrix::from_fn(n, n, |i, j| 0.5 * (sys.k[(i, j)] + sys.k[(j, i)]));
+    let small = SecondOrder {
+        m: cb.project(&sys.m),
+        k: cb.project(&ks),
+        c: DMatrix::zeros(r, r),
+    };
+    let ritz = undamped_basis(&small, Basis::Modes(r))?;
+    let t = to_faer(&cb.t);
+    let phi = &t * &ritz.phi;
+    let nb = boundary.len();
+    let mut omega2 = cb.omega2.clone();
+    omega2.extend(ritz.omega2[r - nb.min(r)..].iter().copied());
+    Ok(UndampedBasis {
+        phi,
+        omega2,
+        static_vectors: nb.min(r),
+    })
 }
 
 /// One row of the truncation table ([`truncation_table`]): the projected
@@ -426,7 +485,11 @@ pub struct Truncation {
 pub fn truncation_table(
     sys: &SecondOrder,
     basis: Basis,
+    kind: BasisKind,
 ) -> Result<Vec<Truncation>, StabilityError> {
+    if kind == BasisKind::CraigBampton {
+        return craig_bampton_truncation(sys, basis);
+    }
     let full = undamped_basis(sys, basis)?;
     let m = full.phi.ncols();
     let dofs = coupling_dofs(sys);
@@ -454,10 +517,49 @@ pub fn truncation_table(
                 modes: k,
                 basis_max_hz: full.omega2[k - 1].max(0.0).sqrt() / std::f64::consts::TAU,
                 static_vectors: b.static_vectors,
-                eigenvalues: eigenvalues(&a)?
-                    .into_iter()
-                    .filter(|e| e.im >= 0.0)
-                    .collect(),
+                eigenvalues: upper_eigenvalues(&a)?,
+            })
+        })
+        .collect()
+}
+
+/// The eigenvalues of `a` with `ω ≥ 0` (a row of the truncation table).
+fn upper_eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, StabilityError> {
+    Ok(eigenvalues(a)?
+        .into_iter()
+        .filter(|e| e.im >= 0.0)
+        .collect())
+}
+
+/// [`truncation_table`] of a Craig–Bampton basis: a quarter, half, three
+/// quarters and all of its fixed-interface modes (the contact dofs in every
+/// row; the interior's modes are recomputed for each).
+fn craig_bampton_truncation(
+    sys: &SecondOrder,
+    basis: Basis,
+) -> Result<Vec<Truncation>, StabilityError> {
+    let full = craig_bampton_basis(sys, basis)?;
+    let m = full.phi.ncols() - full.static_vectors;
+    let mut counts: Vec<usize> = [1usize, 2, 3, 4]
+        .iter()
+        .map(|q| (m * q).div_ceil(4))
+        .collect();
+    counts.dedup();
+    counts
+        .into_iter()
+        .map(|k| {
+            let b = if k == m {
+                full.clone()
+            } else {
+                craig_bampton_basis(sys, Basis::Modes(k))?
+            };
+            let a = reduced_state_matrix(sys, &b);
+            Ok(Truncation {
+                modes: k,
+                basis_max_hz: b.omega2[..k].last().map_or(0.0, |w2| w2.max(0.0).sqrt())
+                    / std::f64::consts::TAU,
+                static_vectors: b.static_vectors,
+                eigenvalues: upper_eigenvalues(&a)?,
             })
         })
         .collect()
@@ -468,10 +570,11 @@ pub fn truncation_table(
 pub fn projected_eigenvalues(
     sys: &SecondOrder,
     basis: Basis,
+    kind: BasisKind,
 ) -> Result<(Vec<Complex<f64>>, Method), StabilityError> {
-    let b = corrected_basis(sys, basis)?;
+    let b = basis_of(sys, basis, kind)?;
     let a = reduced_state_matrix(sys, &b);
-    Ok((eigenvalues(&a)?, method(sys, &b)))
+    Ok((eigenvalues(&a)?, method(sys, &b, kind)))
 }
 
 /// Complex eigenvalue analysis by projection (see the module docs): the
@@ -489,6 +592,7 @@ pub fn analyse_projected(
     state_names: &[String],
     masses: Option<&[f64]>,
     basis: Basis,
+    kind: BasisKind,
 ) -> Result<Analysis, StabilityError> {
     use faer::linalg::matmul::matmul;
     use faer::{Accum, Mat, Par};
@@ -507,7 +611,7 @@ pub fn analyse_projected(
             )));
         }
     }
-    let b = corrected_basis(sys, basis)?;
+    let b = basis_of(sys, basis, kind)?;
     let a = reduced_state_matrix(sys, &b);
     let pairs = eigenpairs(&a)?;
     let m = b.phi.ncols();
@@ -550,6 +654,6 @@ pub fn analyse_projected(
         })
         .collect();
     let mut an = finish(modes, z.to_vec());
-    an.method = method(sys, &b);
+    an.method = method(sys, &b, kind);
     Ok(an)
 }

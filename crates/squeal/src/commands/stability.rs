@@ -75,8 +75,18 @@ fn modal_line(an: &Analysis) -> Option<String> {
             dofs,
             basis_max_hz,
             static_vectors,
+            basis: squeal_core::stability::projected::BasisKind::Modes,
         } => Some(format!(
             "projected onto the {modes} lowest undamped modes of {dofs} dofs (up to {basis_max_hz:.1} Hz) and {static_vectors} static-correction vectors at the contact dofs: a reduced-basis answer for the modes in that band, none above it (modal.modes / modal.cutoff_hz / modal.dense_max_dofs choose)"
+        )),
+        squeal_core::stability::projected::Method::Projected {
+            modes,
+            dofs,
+            basis_max_hz,
+            static_vectors,
+            basis: squeal_core::stability::projected::BasisKind::CraigBampton,
+        } => Some(format!(
+            "projected onto a Craig–Bampton basis of {dofs} dofs: the {static_vectors} contact dofs kept physical and {modes} fixed-interface modes (up to {basis_max_hz:.1} Hz): a reduced-basis answer for the modes in that band, none above it (modal.basis / modal.modes / modal.cutoff_hz / modal.dense_max_dofs choose)"
         )),
     }
 }
