@@ -4,7 +4,7 @@ pad spectrum, and one transient point — in one figure.
 Run it as is from the repository (after `pip install ./python matplotlib`):
 
     python examples/python/squeal_tour.py            # writes docs/python-tour.png
-    python examples/python/squeal_tour.py out.png    # or anywhere else
+    python examples/python/squeal_tour.py out.png    # or anywhere else (a folder: its python-tour.png)
 """
 
 import pathlib
@@ -19,6 +19,8 @@ import numpy as np  # noqa: E402
 import squeal  # noqa: E402
 
 out = pathlib.Path(sys.argv[1]) if len(sys.argv) > 1 else pathlib.Path(__file__).resolve().parents[2] / "docs" / "python-tour.png"
+if out.is_dir():
+    out = out / "python-tour.png"
 
 # 1. Linear stability of steady sliding over sliding speed V × normal load N
 #    (parallel, deterministic; an xarray.Dataset when xarray is installed).
@@ -32,8 +34,8 @@ f, psd = run.spectra["vx_p"]
 
 # 3. One transient point: a fast, lightly loaded brake, where the map says it squeals.
 point = dict(V=12.0, N=600.0)
-st = squeal.stability("disc-pad", levers=False, **point)
-tr = squeal.simulate("disc-pad", duration=0.5, **point)
+st = squeal.stability("disc-pad", levers=False, V=point["V"], N=point["N"])
+tr = squeal.simulate("disc-pad", duration=0.5, V=point["V"], N=point["N"])
 
 fig, ax = plt.subplots(1, 3, figsize=(16, 4.6), constrained_layout=True)
 lim = np.nanpercentile(np.abs(sigma), 98)

@@ -40,12 +40,15 @@ __all__ = [
     "branch",
     "critical",
     "cycle",
+    "inspect",
     "map",
+    "reduce",
     "scenario",
     "scenarios",
     "simulate",
     "stability",
     "sweep",
+    "validate",
 ]
 
 Scenario = Union[str, "os.PathLike[str]", Mapping[str, Any]]
@@ -100,12 +103,12 @@ def scenarios() -> List[str]:
     return list(_squeal.scenarios())
 
 
-def scenario(name: Scenario = "disc-pad", *, set=None, **params) -> Dict[str, Any]:
+def scenario(name: Scenario = "disc-pad", *, set: Optional[Mapping[str, Any]] = None, **params: Any) -> Dict[str, Any]:
     """A scenario as a dict with the structure of its TOML file (``squeal
     scenario show``), with overrides applied; edit it and pass it back as the
     ``scenario`` of any function."""
     _, doc = _squeal.scenario_doc(*_source(name), _sets(set, params))
-    return json.loads(doc)
+    return dict(json.loads(doc))
 
 
 class Run:
@@ -119,7 +122,7 @@ class Run:
     summary), ``sample_rate`` (Hz).
     """
 
-    def __init__(self, raw: Dict[str, Any]):
+    def __init__(self, raw: Dict[str, Any]) -> None:
         self.columns: List[str] = list(raw["columns"])
         self.data: np.ndarray = raw["data"]
         self.events: Dict[str, np.ndarray] = {
@@ -144,7 +147,7 @@ class Run:
             raise KeyError(f"{name}: no such column; columns are {', '.join(self.columns)}") from None
 
     def __len__(self) -> int:
-        return self.data.shape[0]
+        return int(self.data.shape[0])
 
     def __repr__(self) -> str:
         return (
@@ -153,13 +156,14 @@ class Run:
             f"verdict {self.summary.get('verdict', '?')}>"
         )
 
-    def to_pandas(self):
+    def to_pandas(self) -> Any:
         """The series as a ``pandas.DataFrame`` indexed by ``t`` (needs pandas)."""
-        import pandas as pd
+        import importlib
 
+        pd: Any = importlib.import_module("pandas")
         return pd.DataFrame(self.data[:, 1:], index=pd.Index(self.t, name="t"), columns=self.columns[1:])
 
-    def to_xarray(self):
+    def to_xarray(self) -> Any:
         """The series as an ``xarray.Dataset`` over ``t`` (needs xarray)."""
         import xarray as xr
 
@@ -170,7 +174,13 @@ class Run:
         )
 
 
-def simulate(scenario: Scenario = "disc-pad", *, duration: Optional[float] = None, set=None, **params) -> Run:
+def simulate(
+    scenario: Scenario = "disc-pad",
+    *,
+    duration: Optional[float] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
+) -> Run:
     """Integrate a scenario (``squeal simulate``): a :class:`Run`."""
     return Run(_squeal.simulate(*_source(scenario), _sets(set, params), duration))
 
@@ -188,7 +198,7 @@ class Stability:
     verdict), ``to_dict()`` (the document of ``squeal stability --json``).
     """
 
-    def __init__(self, raw: Dict[str, Any]):
+    def __init__(self, raw: Dict[str, Any]) -> None:
         self.eigenvalues: np.ndarray = raw["eigenvalues"]
         self.frequencies_hz: np.ndarray = raw["frequencies_hz"]
         self.damping_ratios: np.ndarray = raw["damping_ratios"]
@@ -214,7 +224,7 @@ class Stability:
     @property
     def levers(self) -> List[Dict[str, Any]]:
         """One-parameter changes that flip the verdict: ``param, from, to, freq_hz``."""
-        return self._document()["levers"]
+        return list(self._document()["levers"])
 
     @property
     def growth_rates(self) -> np.ndarray:
@@ -223,14 +233,20 @@ class Stability:
 
     def to_dict(self) -> Dict[str, Any]:
         """The document ``squeal stability --json`` prints."""
-        return json.loads(self._text)
+        return dict(json.loads(self._text))
 
     def __repr__(self) -> str:
         verdict = "stable" if self.stable else "neutral" if self.neutral else "unstable"
         return f"<squeal.Stability {verdict}: max growth rate {self.eigenvalues[0].real:+.6e} 1/s>"
 
 
-def stability(scenario: Scenario = "disc-pad", *, levers: bool = True, set=None, **params) -> Stability:
+def stability(
+    scenario: Scenario = "disc-pad",
+    *,
+    levers: bool = True,
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
+) -> Stability:
     """Stability of steady sliding (``squeal stability``): a :class:`Stability`.
     ``levers=False`` skips the search for verdict-flipping parameter changes
     (hundreds of analyses)."""
@@ -255,9 +271,9 @@ def map(
     log_y: bool = False,
     duration: Optional[float] = None,
     threads: Optional[int] = None,
-    set=None,
-    **params,
-):
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
+) -> Any:
     """Stability over a grid of two parameters (``squeal map``), in parallel
     and deterministic (any ``threads``: the same bits).
 
@@ -299,8 +315,8 @@ def critical(
     *,
     param: Tuple[str, float, float] = ("V", 1.0, 16.5),
     grid: int = 64,
-    set=None,
-    **params,
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
 ) -> Dict[str, Any]:
     """Where steady sliding changes stability (``squeal critical``):
     ``{"param", "value", "freq_hz"}`` (plus ``direction`` and
@@ -312,30 +328,149 @@ def critical(
         lo, hi = float(lo), float(hi)
     except (TypeError, ValueError):
         raise ScenarioError(f"param {param!r}: expected (NAME, LO, HI)") from None
-    return json.loads(_squeal.critical(*_source(scenario), _sets(set, params), str(name), lo, hi, int(grid)))
+    return dict(json.loads(_squeal.critical(*_source(scenario), _sets(set, params), str(name), lo, hi, int(grid))))
 
 
 def sweep(
     scenario: Scenario = "disc-pad",
     *,
     param: Axis,
-    set=None,
-    **params,
-) -> Dict[str, Any]:
-    """Eigenvalues tracked along one parameter (``squeal sweep``):
-    ``{"param", "values", "eigenvalues" (values × branches, complex128),
-    "growth_rates", "frequencies_hz", "listed"}`` (``listed``: the branches
-    the CLI lists, one per mode)."""
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
+) -> Any:
+    """Eigenvalues tracked along one parameter (``squeal sweep``).
+
+    ``param`` is ``(NAME, LO, HI, N)`` as ``--param``. With xarray
+    installed, an ``xarray.Dataset`` over the dimensions ``NAME`` (the
+    parameter values, with their ``units``) and ``branch`` (eigenvalues
+    followed by mode matching, the CLI's branches): ``eigenvalue``
+    (complex128, 1/s), ``growth_rate`` (Re λ, 1/s), ``freq_hz`` (|Im λ|/2π,
+    Hz), ``listed`` (bool per branch: the ones the CLI lists, one per mode),
+    and the attributes ``onset_value``, ``onset_freq_hz`` (Hz),
+    ``onset_direction`` (``destabilising``/``stabilising``) and
+    ``onset_coalescence`` (1 where two modes coalesce, 0 for a lone
+    crossing) — one entry per change of the number of growing eigenvalues.
+    Every variable and coordinate has ``units`` and ``long_name``.
+    Without xarray, a dict: ``param``, ``values``, ``eigenvalues`` (values ×
+    branches), ``growth_rates``, ``frequencies_hz``, ``listed`` (indices),
+    ``onsets`` (list of dicts).
+    """
     raw = _squeal.sweep(*_source(scenario), _sets(set, params), _axis(param, "param"))
     lam = raw["eigenvalues"]
-    return {
-        "param": raw["param"],
-        "values": raw["values"],
-        "eigenvalues": lam,
-        "growth_rates": lam.real.copy(),
-        "frequencies_hz": np.abs(lam.imag) / (2 * np.pi),
-        "listed": list(raw["listed"]),
+    onsets = json.loads(raw["onsets"])
+    try:
+        import xarray as xr
+    except ImportError:
+        return {
+            "param": raw["param"],
+            "values": raw["values"],
+            "eigenvalues": lam,
+            "growth_rates": lam.real.copy(),
+            "frequencies_hz": np.abs(lam.imag) / (2 * np.pi),
+            "listed": list(raw["listed"]),
+            "onsets": onsets,
+        }
+    name = raw["param"]
+    nb = lam.shape[1]
+    listed = np.zeros(nb, dtype=bool)
+    listed[list(raw["listed"])] = True
+    ds = xr.Dataset(
+        {
+            "eigenvalue": ((name, "branch"), lam),
+            "growth_rate": ((name, "branch"), lam.real.copy()),
+            "freq_hz": ((name, "branch"), np.abs(lam.imag) / (2 * np.pi)),
+            "listed": (("branch",), listed),
+        },
+        coords={name: raw["values"], "branch": np.arange(nb)},
+        attrs={
+            "onset_value": [float(o["value"]) for o in onsets],
+            "onset_freq_hz": [float(o["freq_hz"]) for o in onsets],
+            "onset_direction": [str(o["direction"]) for o in onsets],
+            "onset_coalescence": [int(bool(o["coalescence"])) for o in onsets],
+        },
+    )
+    meta = {
+        name: (raw["unit"], f"parameter {name}"),
+        "branch": ("1", "eigenvalue branch (followed by mode matching)"),
+        "eigenvalue": ("1/s", "eigenvalue λ = σ + iω of the linearised steady sliding"),
+        "growth_rate": ("1/s", "growth rate σ = Re λ"),
+        "freq_hz": ("Hz", "frequency |Im λ|/2π"),
+        "listed": ("1", "branch listed by the CLI (one per mode)"),
     }
+    for k, (units, long_name) in meta.items():
+        ds[k].attrs.update(units=units, long_name=long_name)
+    return ds
+
+
+def validate(filter: Optional[str] = None) -> Dict[str, Any]:
+    """squeal's benchmark cases (``squeal validate --json``): ``{"cases":
+    [{"name", "kind", "quantity", "unit", "reference", "source", "value",
+    "error", "error_kind", "tolerance", "pass", "detail"}], "passed",
+    "failed"}``; ``filter`` keeps the cases whose name contains it."""
+    return dict(json.loads(_squeal.validate(filter)))
+
+
+def inspect(scenario: Scenario = "disc-pad", *, set: Optional[Mapping[str, Any]] = None, **params: Any) -> Dict[str, Any]:
+    """What a scenario's files hold (``squeal inspect --json``): each
+    matrix's format, file, size, nonzeros and symmetry, the dofs, the lowest
+    natural frequencies without friction (Hz), each contact with its dofs."""
+    return dict(json.loads(_squeal.inspect(*_source(scenario), _sets(set, params))))
+
+
+def reduce(
+    scenario: Scenario,
+    *,
+    out: Optional[Union[str, "os.PathLike[str]"]] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
+) -> Dict[str, Any]:
+    """A lumped (FE) model reduced by Craig–Bampton (``squeal reduce``):
+    every dof the scenario names kept physical, the interior's
+    fixed-interface modes up to ``modal.cutoff_hz`` (Hz; or the
+    ``modal.modes`` lowest).
+
+    The record (``reduce.json``: ``boundary``, ``generalised``,
+    ``modes_hz`` (Hz), ``interior_modes``, ``dofs``, ``basis``,
+    ``shifted``), plus ``toml`` (the reduced scenario) and ``M`` (kg), ``K``
+    (N/m), ``C`` (N·s/m; absent without a damping file) as dense arrays on
+    ``boundary + generalised``. With ``out``, also writes that folder
+    (``scenario.toml``, ``M.mtx``, ``K.mtx``, ``C.mtx``, ``reduce.json``) —
+    a new folder only: an existing ``out`` is refused, never replaced —
+    and ``squeal.simulate(out + "/scenario.toml")`` runs it.
+    """
+    raw = _squeal.reduce(*_source(scenario), _sets(set, params))
+    doc: Dict[str, Any] = json.loads(raw["document"])
+    files = {"scenario.toml": raw["toml"], "reduce.json": json.dumps(doc, indent=2) + "\n"}
+    for k in ("M", "K", "C"):
+        if k in raw:
+            doc[k] = raw[k]
+            files[f"{k}.mtx"] = raw[f"{k}.mtx"]
+    doc["toml"] = raw["toml"]
+    if out is not None:
+        _write_new_folder(os.fspath(out), files)
+    return doc
+
+
+def _write_new_folder(out: str, files: Mapping[str, str]) -> None:
+    """Write ``files`` into the new folder ``out``: staged beside it and
+    renamed into place, so that an interrupted call leaves nothing."""
+    import shutil
+    import tempfile
+
+    if os.path.lexists(out):
+        raise ScenarioError(f"out = {out!r}: exists; reduce writes a new folder and never replaces one")
+    parent = os.path.dirname(os.path.abspath(out))
+    if not os.path.isdir(parent):
+        raise ScenarioError(f"out = {out!r}: its folder {parent!r} does not exist")
+    tmp = tempfile.mkdtemp(prefix=".squeal-reduce-", dir=parent)
+    try:
+        for name, text in files.items():
+            with open(os.path.join(tmp, name), "w", encoding="utf-8") as f:
+                f.write(text)
+        os.rename(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
 
 
 def cycle(
@@ -345,8 +480,8 @@ def cycle(
     settle_steps: int = 20_000_000,
     settle_time: float = 1000.0,
     settle_tol: float = 1e-2,
-    set=None,
-    **params,
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
 ) -> Dict[str, Any]:
     """The limit cycle the scenario settles on (``squeal cycle --json``):
     the CLI's document (``period``, ``multipliers`` as ``{re, im, abs}``,
@@ -362,7 +497,7 @@ def cycle(
         float(settle_tol),
         section,
     )
-    doc = json.loads(raw["document"])
+    doc: Dict[str, Any] = json.loads(raw["document"])
     if "orbit" in raw:
         doc["orbit_columns"] = list(raw["orbit_columns"])
         doc["orbit"] = raw["orbit"]
@@ -374,11 +509,11 @@ def branch(
     scenario: Scenario = "disc-pad",
     *,
     param: Axis,
-    set=None,
-    **params,
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
 ) -> Dict[str, Any]:
     """Continuation of the limit cycle over one parameter
     (``squeal branch --json``): the CLI's document (``points`` with period,
     amplitudes, multipliers and stability; ``bifurcations``; ``segments``;
     ``hopf``). ``param`` is ``(NAME, LO, HI, N)`` as ``--param``."""
-    return json.loads(_squeal.branch(*_source(scenario), _sets(set, params), _axis(param, "param")))
+    return dict(json.loads(_squeal.branch(*_source(scenario), _sets(set, params), _axis(param, "param"))))

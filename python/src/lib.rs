@@ -427,8 +427,8 @@ fn stability_map<'py>(
     Ok(out)
 }
 
-/// The critical value of `name` in `[lo, hi]`: `(value, freq_hz, direction,
-/// from_neutral)` or `None`.
+/// The critical value of `name` in `[lo, hi]` (`squeal critical --json`'s
+/// document as JSON text; `value` and `freq_hz` null when nothing crosses).
 #[pyfunction]
 fn critical(
     py: Python<'_>,
@@ -439,7 +439,7 @@ fn critical(
     lo: f64,
     hi: f64,
     grid: usize,
-) -> PyResult<Option<String>> {
+) -> PyResult<String> {
     let sc = resolve(kind, text, &sets)?;
     let found = compute(py, |cancel| {
         squeal_study::critical::locate(&sc.model, &name, lo, hi, grid, cancel)
@@ -452,7 +452,7 @@ fn critical(
         }),
     };
     doc["modal"] = squeal_study::stability::modal_options_json(&sc.model);
-    Ok(Some(json_text(&doc)?))
+    json_text(&doc)
 }
 
 /// An eigenvalue sweep: values, the eigenvalues (values × branches) and the
@@ -480,6 +480,76 @@ fn sweep<'py>(
     out.set_item("values", sw.values.clone().into_pyarray(py))?;
     out.set_item("eigenvalues", lambda.into_pyarray(py))?;
     out.set_item("listed", sw.listed.clone())?;
+    out.set_item("unit", map::unit_of(&sc.model, &ax.name))?;
+    out.set_item("onsets", json_text(&serde_json::json!(sw.onsets))?)?;
+    Ok(out)
+}
+
+/// `squeal validate --json`'s document as JSON text (`filter`: the cases
+/// whose name contains it; none matching is bad input, as in the CLI).
+#[pyfunction]
+#[pyo3(signature = (filter=None))]
+fn validate(py: Python<'_>, filter: Option<String>) -> PyResult<String> {
+    if let Some(f) = &filter {
+        if !squeal_study::validate::specs()
+            .iter()
+            .any(|s| s.name.contains(f.as_str()))
+        {
+            return Err(ScenarioError::new_err(format!(
+                "no validation case's name contains {f:?}"
+            )));
+        }
+    }
+    let cases = compute(py, |_| {
+        Ok(squeal_study::validate::run(filter.as_deref(), &NoProgress))
+    })?;
+    let passed = cases.iter().filter(|c| c.pass).count();
+    json_text(&serde_json::json!({
+        "cases": cases,
+        "passed": passed,
+        "failed": cases.len() - passed,
+    }))
+}
+
+/// `squeal inspect --json`'s document as JSON text.
+#[pyfunction]
+fn inspect(py: Python<'_>, kind: &str, text: &str, sets: Vec<String>) -> PyResult<String> {
+    let sc = resolve(kind, text, &sets)?;
+    let report = compute(py, |_| Ok(squeal_study::inspect::inspect(&sc)))?;
+    json_text(&serde_json::to_value(&report).map_err(|e| SquealError::new_err(e.to_string()))?)
+}
+
+/// A Craig–Bampton reduction (`squeal reduce`): the record (`reduce.json`)
+/// as JSON text, the reduced scenario's TOML, and the reduced matrices both
+/// dense (`M`, `K`, `C`) and as Matrix Market text (`M.mtx`, …).
+#[pyfunction]
+fn reduce<'py>(
+    py: Python<'py>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let sc = resolve(kind, text, &sets)?;
+    let red = compute(py, |_| squeal_study::reduce::reduce(&sc))?;
+    let out = PyDict::new(py);
+    let doc = serde_json::to_value(&red).map_err(|e| SquealError::new_err(e.to_string()))?;
+    out.set_item("document", json_text(&doc)?)?;
+    out.set_item("toml", &red.toml)?;
+    let n = red.reduced_dofs();
+    let mats = [
+        ("M", Some(&red.m)),
+        ("K", Some(&red.k)),
+        ("C", red.c.as_ref()),
+    ];
+    for (name, t) in mats {
+        let Some(t) = t else { continue };
+        let mut d = Array2::<f64>::zeros((n, n));
+        for &(r, c, v) in &t.entries {
+            d[(r, c)] += v;
+        }
+        out.set_item(name, d.into_pyarray(py))?;
+        out.set_item(format!("{name}.mtx"), squeal_core::matrix_market::write(t))?;
+    }
     Ok(out)
 }
 
@@ -573,5 +643,8 @@ fn _squeal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(cycle, m)?)?;
     m.add_function(wrap_pyfunction!(branch, m)?)?;
+    m.add_function(wrap_pyfunction!(validate, m)?)?;
+    m.add_function(wrap_pyfunction!(inspect, m)?)?;
+    m.add_function(wrap_pyfunction!(reduce, m)?)?;
     Ok(())
 }

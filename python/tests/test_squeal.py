@@ -165,10 +165,58 @@ def test_critical_refuses_a_grid_out_of_range():
             squeal.critical("hoffmann", param=("mu", 0.0, 1.0), grid=grid)
 
 
-def test_sweep_shapes():
+def test_sweep_is_a_dataset_with_units(cli, tmp_path):
     sw = squeal.sweep(param=("c_px", 0.05, 0.5, 11))
-    assert sw["eigenvalues"].shape == (11, 8) and sw["eigenvalues"].dtype == np.complex128
-    assert len(sw["listed"]) == 4
+    assert sw["eigenvalue"].shape == (11, 8) and sw["eigenvalue"].dtype == np.complex128
+    assert sw["eigenvalue"].dims == ("c_px", "branch")
+    assert int(sw["listed"].sum()) == 4
+    for name in list(sw.data_vars) + list(sw.coords):
+        assert sw[name].attrs["units"] and sw[name].attrs["long_name"], name
+    assert sw["c_px"].attrs["units"] == "kg/s" and sw["freq_hz"].attrs["units"] == "Hz"
+    np.testing.assert_array_equal(sw["growth_rate"].values, sw["eigenvalue"].values.real)
+    # Hoffmann's coalescence: the onsets are the CLI's, to the bit.
+    h = squeal.sweep("hoffmann", param=("mu", 0.0, 1.0, 21))
+    doc = json.loads(cli("sweep", "hoffmann", "--param", "mu=0:1:21", "--json", "--out", str(tmp_path / "s")))
+    assert [o["value"] for o in doc["onsets"]] == h.attrs["onset_value"]
+    assert [o["freq_hz"] for o in doc["onsets"]] == h.attrs["onset_freq_hz"]
+    assert [o["direction"] for o in doc["onsets"]] == h.attrs["onset_direction"] == ["destabilising"]
+    assert h.attrs["onset_coalescence"] == [1]
+
+
+def test_validate_equals_cli_json(cli):
+    doc = json.loads(cli("validate", "hoffmann", "--json"))
+    assert squeal.validate("hoffmann") == doc
+    assert doc["passed"] == 3 and doc["failed"] == 0
+    with pytest.raises(squeal.ScenarioError, match="no validation case's name contains"):
+        squeal.validate("no-such-case")
+
+
+FE_BRAKE = pathlib.Path(__file__).resolve().parents[2] / "examples" / "fe-brake" / "two-pad" / "brake.toml"
+
+
+def test_inspect_equals_cli_json(cli):
+    assert squeal.inspect(FE_BRAKE) == json.loads(cli("inspect", str(FE_BRAKE), "--json"))
+
+
+def test_reduce_writes_a_scenario_that_runs_like_the_clis(cli, tmp_path):
+    out = tmp_path / "r"
+    red = squeal.reduce(FE_BRAKE, out=out, set={"modal.cutoff_hz": 2100})
+    assert red["boundary"] == ["6_1", "6_3", "6_5", "9001_1", "9001_3", "9002_1", "9002_3"]
+    n = len(red["boundary"]) + len(red["generalised"])
+    assert red["M"].shape == (n, n) and np.array_equal(red["M"], red["M"].T)
+    assert sorted(p.name for p in out.iterdir()) == ["C.mtx", "K.mtx", "M.mtx", "reduce.json", "scenario.toml"]
+    cli("reduce", str(FE_BRAKE), "--set", "modal.cutoff_hz=2100", "--out", str(tmp_path / "c"))
+    for f in ("scenario.toml", "M.mtx", "K.mtx", "C.mtx"):
+        assert (out / f).read_text() == (tmp_path / "c" / f).read_text(), f
+    assert json.loads((out / "reduce.json").read_text()) == json.loads((tmp_path / "c" / "reduce.json").read_text())
+    st = squeal.stability(out / "scenario.toml", levers=False)
+    assert st.growth_rates.max() > 300
+    # An existing folder is never replaced, and nothing is left behind.
+    with pytest.raises(squeal.ScenarioError, match="exists"):
+        squeal.reduce(FE_BRAKE, out=out)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c", "r"]
+    with pytest.raises(squeal.ScenarioError, match="only a lumped model"):
+        squeal.reduce("disc-pad")
 
 
 def test_bad_key_raises_scenario_error_naming_it():
