@@ -23,6 +23,7 @@ pub mod map;
 pub mod matrix_file;
 pub mod memory;
 pub mod model;
+pub mod plan;
 pub mod radiation;
 pub mod reduce;
 pub mod reproduce;

@@ -188,3 +188,44 @@ fn the_projected_analysis_takes_a_craig_bampton_basis() {
         "{e}"
     );
 }
+
+/// A long command states what it will compute before it starts (issue 27
+/// §1): an FE model's size, its files' nonzeros, the method and its
+/// memory, one line on stderr; a small model's analysis says nothing.
+#[test]
+fn long_commands_state_what_they_will_compute() {
+    let d = tempfile::tempdir().unwrap();
+    let b = brake();
+    let b = b.to_str().unwrap();
+    let out = squeal(d.path(), &["stability", b, "--no-levers"]);
+    ok(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.starts_with("stability: two-pad: 124 dofs (C 528 nonzeros, K 528 nonzeros, M 524 nonzeros); steady sliding, then the dense complex eigenvalue problem of 248 states; up to 5 MB"),
+        "{err}"
+    );
+    let out = squeal(
+        d.path(),
+        &[
+            "critical",
+            b,
+            "--param",
+            "mu=0.1:0.6",
+            "--set",
+            "modal.dense_max_dofs=0",
+        ],
+    );
+    ok(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("the real modes of all 124 dofs") && err.contains(", 64 times;"),
+        "{err}"
+    );
+    let out = squeal(d.path(), &["stability", "disc-pad", "--no-levers"]);
+    ok(&out);
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -50,6 +50,9 @@ pub fn parse_interval(spec: &str, flag: &str) -> Result<(String, f64, f64), Inpu
 pub fn run(a: CriticalArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
     let (name, lo, hi) = parse_interval(&a.param, "--param")?;
+    if let Some(p) = squeal_study::plan::plan(&sc, "critical", a.grid) {
+        crate::errln!("{p} (a grid of {}, then bisection)", a.grid);
+    }
     let found = locate(&sc.model, &name, lo, hi, a.grid, &crate::run::NEVER)?;
     if a.json {
         let mut doc = match &found {

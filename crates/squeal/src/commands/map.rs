@@ -328,6 +328,9 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
         Some(s) => format!("shard {}/{}: {what}", s.k, s.n),
         None => what.to_string(),
     };
+    if let Some(p) = squeal_study::plan::plan(&sc, "map", points.len()) {
+        crate::errln!("{p}");
+    }
     let pb = progress_bar(points.len() as u64, &share("eigen-analysis"));
     let lin = linear_grid(&sc.model, &x, &y, &points, &pb, &NEVER)?;
     squeal_study::Progress::finish(&pb);

@@ -97,6 +97,9 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     if let Some(dest) = &a.out {
         crate::staging::check_dest_as("--out", dest)?;
     }
+    if let Some(p) = squeal_study::plan::plan(&sc, "stability", 1) {
+        crate::errln!("{p}");
+    }
     let an =
         analyse(&sc.model).map_err(|e| squeal_study::feasible::stability_failure(&sc.model, e))?;
     if let Some(dest) = &a.out {

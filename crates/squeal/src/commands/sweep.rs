@@ -66,6 +66,9 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
     }
     let name = Shard::folder(&format!("{}-sweep", sc.name), shard);
     let stage = Staging::for_out(a.out.as_deref(), &name)?;
+    if let Some(p) = squeal_study::plan::plan(&sc, "sweep", axis.values.len()) {
+        crate::errln!("{p}");
+    }
     let unit = unit_of(&sc.model, &axis.name);
     let xl = if unit.is_empty() {
         axis.name.clone()
