@@ -229,3 +229,54 @@ fn long_commands_state_what_they_will_compute() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// The reduced brake in the other transient commands: `map --transient`
+/// (its watched velocity found from the contacts' tangential dofs, which
+/// FE names like `6_1` do not announce: before, every point `failed`),
+/// `listen`, and with modes to 1.4 kHz (11 dofs) `cycle`, whose limit cycle
+/// is stable with its 4 sticks and 2 separations a period.
+#[test]
+fn the_reduced_brake_maps_listens_and_cycles() {
+    let d = tempfile::tempdir().unwrap();
+    reduce(d.path(), "r", &[]);
+    let p = d.path().join("r/scenario.toml");
+    let p = p.to_str().unwrap();
+    ok(&squeal(
+        d.path(),
+        &[
+            "map",
+            p,
+            "--x",
+            "mu=0.3:0.6:2",
+            "--y",
+            "Fb=1500:2500:2",
+            "--transient",
+            "--duration",
+            "0.05",
+            "--out",
+            "m",
+        ],
+    ));
+    let csv = std::fs::read_to_string(d.path().join("m/map.csv")).unwrap();
+    let outcomes: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(4).unwrap())
+        .collect();
+    assert_eq!(outcomes.len(), 4);
+    assert!(!outcomes.contains(&"failed"), "{csv}");
+    assert_eq!(outcomes[1], "grows", "{csv}");
+    ok(&squeal(d.path(), &["listen", p, "--out", "s.wav"]));
+    assert!(d.path().join("s.wav").metadata().unwrap().len() > 1000);
+    reduce(d.path(), "r11", &["modal.cutoff_hz=1400"]);
+    let p11 = d.path().join("r11/scenario.toml");
+    let c = json(&squeal(
+        d.path(),
+        &["cycle", p11.to_str().unwrap(), "--json"],
+    ));
+    assert_eq!(c["stable"], true, "{c}");
+    let f = c["frequency_hz"].as_f64().unwrap();
+    assert!((f - 605.22).abs() < 0.01, "{f}");
+    assert_eq!(c["events_per_period"]["stick"], 4, "{c}");
+    assert_eq!(c["events_per_period"]["separate"], 2, "{c}");
+}
