@@ -43,6 +43,7 @@ __all__ = [
     "inspect",
     "map",
     "reduce",
+    "reproduce",
     "scenario",
     "scenarios",
     "simulate",
@@ -400,6 +401,29 @@ def sweep(
     for k, (units, long_name) in meta.items():
         ds[k].attrs.update(units=units, long_name=long_name)
     return ds
+
+
+def reproduce(*, duration_scale: float = 1.0) -> Dict[str, Any]:
+    """The thesis reproduced (``squeal reproduce`` without its report files):
+    the 40 reconstructed sets run and measured in parallel, the sweeps
+    around set 15 and the seven conclusions graded.
+
+    ``table_csv`` (the text of ``table.csv``), ``sets`` (its rows as dicts of
+    strings, keyed by its header: ``set``, ``V`` (m/s), ``N`` (N), …,
+    ``max_growth_rate`` (1/s), ``squeal_frequency_hz`` (Hz), ``erp_db``,
+    ``spl_dba``), ``conclusions`` (``conclusions.json``: ``id``, ``thesis``,
+    ``claim``, ``held``, ``grade``, ``caveat``, ``evidence``, ``data``).
+    ``duration_scale`` scales every set's duration (the CLI's
+    ``--duration-scale``)."""
+    import csv
+    import io
+
+    table, conclusions = _squeal.reproduce(float(duration_scale))
+    return {
+        "table_csv": table,
+        "sets": list(csv.DictReader(io.StringIO(table))),
+        "conclusions": json.loads(conclusions),
+    }
 
 
 def validate(filter: Optional[str] = None) -> Dict[str, Any]:

@@ -485,6 +485,32 @@ fn sweep<'py>(
     Ok(out)
 }
 
+/// The thesis reproduced (`squeal reproduce`'s content without its files):
+/// `table.csv`'s text and `conclusions.json`'s document as JSON text.
+#[pyfunction]
+#[pyo3(signature = (duration_scale=1.0))]
+fn reproduce(py: Python<'_>, duration_scale: f64) -> PyResult<(String, String)> {
+    use squeal_study::reproduce as rp;
+    let sets = rp::prepared_sets(duration_scale).map_err(study_err)?;
+    let (table, conclusions) = compute(py, |cancel| {
+        let ids: Vec<usize> = (0..sets.len()).collect();
+        let mut rs = Vec::with_capacity(ids.len());
+        for (i, r) in rp::measure_sets(&sets, &ids, |_, _, _, _| Ok(()), &NoProgress, cancel)
+            .into_iter()
+            .enumerate()
+        {
+            rs.push(r.map_err(|e: StudyError| match e {
+                StudyError::Interrupted => e,
+                other => StudyError::Numerical(format!("set {}: {other}", i + 1)),
+            })?);
+        }
+        let sw = rp::sweeps(&rs[14].sc, cancel)?;
+        let cs = rp::conclusions(&rs, &sw);
+        Ok((rp::table_csv(&rs), rp::conclusions_json(&cs)))
+    })?;
+    Ok((table, json_text(&serde_json::Value::Array(conclusions))?))
+}
+
 /// `squeal validate --json`'s document as JSON text (`filter`: the cases
 /// whose name contains it; none matching is bad input, as in the CLI).
 #[pyfunction]
@@ -646,5 +672,6 @@ fn _squeal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add_function(wrap_pyfunction!(inspect, m)?)?;
     m.add_function(wrap_pyfunction!(reduce, m)?)?;
+    m.add_function(wrap_pyfunction!(reproduce, m)?)?;
     Ok(())
 }

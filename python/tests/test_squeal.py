@@ -340,3 +340,14 @@ def test_cycle_and_branch_bad_input_names_the_flag():
         squeal.cycle("disc-pad", settle_time=-1.0)
     with pytest.raises(squeal.ScenarioError, match="bogus"):
         squeal.branch("disc-pad", param=("bogus", 0.5, 0.6, 3))
+
+
+def test_reproduce_equals_the_clis_table_and_conclusions(cli, tmp_path):
+    cli("reproduce", "--duration-scale", "0.5", "--no-figures", "--out", str(tmp_path / "r"))
+    r = squeal.reproduce(duration_scale=0.5)
+    assert r["table_csv"] == (tmp_path / "r" / "table.csv").read_text()
+    assert r["conclusions"] == json.loads((tmp_path / "r" / "conclusions.json").read_text())
+    assert len(r["sets"]) == 40 and r["sets"][14]["set"] == "15"
+    assert [c["id"] for c in r["conclusions"]] == list(range(1, 8))
+    with pytest.raises(squeal.ScenarioError, match="duration"):
+        squeal.reproduce(duration_scale=-1.0)

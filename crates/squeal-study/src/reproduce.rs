@@ -15,6 +15,7 @@ use serde_json::{json, Value};
 use squeal_core::stability;
 use squeal_core::{EventKind, Model};
 use squeal_signal::Spectrum;
+use std::fmt::Write as _;
 
 /// Linear stability of one set (sets at V = 0 have no steady sliding).
 #[derive(Debug, Clone)]
@@ -1200,6 +1201,117 @@ pub mod exact {
             sc,
         })
     }
+}
+
+/// `x` with `prec` decimals, empty when missing or not finite (a table cell).
+pub fn opt(x: Option<f64>, prec: usize) -> String {
+    x.filter(|v| v.is_finite())
+        .map_or(String::new(), |v| format!("{v:.prec$}"))
+}
+
+/// The parameters the table shows for every set (the ones the sets vary).
+pub const TABLE_PARAMS: [&str; 8] = ["V", "N", "f1", "alpha", "c_dx", "c_dy", "c_px", "c_py"];
+
+/// `table.csv`'s header.
+pub const TABLE_HEADER: &str = "set,question,V,N,f1,alpha,c_dx,c_dy,c_px,c_py,duration,linear,max_growth_rate,least_stable_hz,verdict,tangential_hz,normal_hz,growth_rate_vx_p,growth_rate_vx_d,stick_fraction,reversals,sticks,tangential_zero,agree,squeal_coordinate,squeal_frequency_hz,squeal_level_db,separations,valid,erp_db,spl_dba";
+
+/// `table.csv`: one row per set (its parameters, linear and measured
+/// answers), the same bytes from `reproduce`, `merge` and Python.
+pub fn table_csv(rs: &[SetResult]) -> String {
+    let mut t = String::from(TABLE_HEADER);
+    t.push('\n');
+    for r in rs {
+        let q = r.sc.description.replace('"', "'");
+        let params: Vec<String> = TABLE_PARAMS.iter().map(|k| r.p(k).to_string()).collect();
+        let _ = writeln!(
+            t,
+            "{},\"{}\",{},{},{},{},{},{},{},{},{},{},{:e},{},{},{},{},{},{},{},{},{},{},{}",
+            r.id,
+            q,
+            params.join(","),
+            r.sc.duration,
+            r.linear_word(),
+            r.linear
+                .as_ref()
+                .map_or(String::new(), |l| format!("{:e}", l.max_growth)),
+            r.linear
+                .as_ref()
+                .map_or(String::new(), |l| format!("{:.2}", l.freq_hz)),
+            r.verdict,
+            opt(r.f_t, 2),
+            opt(r.f_n, 2),
+            opt(r.growth_of("vx_p"), 4),
+            opt(r.growth_of("vx_d"), 4),
+            r.stick_fraction,
+            r.events[EventKind::Reverse.index()],
+            r.events[EventKind::Stick.index()],
+            r.tangential_zero,
+            r.agrees().map_or("", |a| if a { "yes" } else { "no" }),
+            r.squeal.as_ref().map_or("", |s| s.coordinate.as_str()),
+            opt(r.squeal.as_ref().map(|s| s.frequency_hz), 2),
+            opt(r.squeal.as_ref().map(|s| s.level_db), 2),
+            r.events[EventKind::Separate.index()],
+            r.outside().is_none(),
+            opt(r.erp_db, 2),
+            opt(r.spl_dba, 2),
+        );
+    }
+    t
+}
+
+/// `conclusions.json`: each conclusion's `id`, `thesis`, `claim`, `held`,
+/// `grade`, `caveat`, `evidence` and `data`.
+pub fn conclusions_json(cs: &[Conclusion]) -> Vec<Value> {
+    cs.iter()
+        .map(|c| json!({ "id": c.id, "thesis": c.thesis, "claim": c.claim, "held": c.grade.held(), "grade": c.grade.as_str(), "caveat": c.caveat, "evidence": c.evidence, "data": c.data }))
+        .collect()
+}
+
+/// Measure the sets `ids` (indices into `sets`, set `i + 1`) in parallel,
+/// calling `after` on each set's run, analysis and answer (the CLI draws
+/// Appendix A's pictures there); results in the order of `ids`, whatever
+/// the number of threads. Each task takes up to four sets
+/// ([`tasks`](crate::run::tasks): fewer when their series would take too
+/// much memory together) and runs them together on its core
+/// ([`run_many`](crate::run::run_many): the disc–pads as one ensemble, bit
+/// for bit their single runs), then analyses each. `progress` counts sets.
+pub fn measure_sets<E, F>(
+    sets: &[Scenario],
+    ids: &[usize],
+    after: F,
+    progress: &dyn crate::error::Progress,
+    cancel: &Cancel,
+) -> Vec<Result<SetResult, E>>
+where
+    E: From<StudyError> + Send,
+    F: Fn(usize, &Run, &Analysis, &crate::answer::Answer) -> Result<(), E> + Sync,
+{
+    use rayon::prelude::*;
+    let all: Vec<&Scenario> = ids.iter().map(|&i| &sets[i]).collect();
+    let results: Vec<Vec<Result<SetResult, E>>> = crate::run::tasks(&all)
+        .into_par_iter()
+        .map(|task| {
+            let chunk = &ids[task.clone()];
+            let scs = &all[task];
+            let runs = crate::run::run_many(scs, &NoProgress, cancel);
+            chunk
+                .iter()
+                .zip(runs)
+                .map(|(&i, run)| {
+                    let sc = sets[i].clone();
+                    let r = run.map_err(E::from).and_then(|run| {
+                        measure_run(i + 1, sc, run, |run, an, answer| {
+                            after(i + 1, run, an, answer)
+                        })
+                    });
+                    progress.inc(1);
+                    r
+                })
+                .collect()
+        })
+        .collect();
+    progress.finish();
+    results.into_iter().flatten().collect()
 }
 
 #[cfg(test)]

@@ -16,7 +16,6 @@ use crate::analysis::{self, Analysis};
 use crate::run::{progress_bar, Run, RunError, Staging, NEVER};
 use clap::Args;
 use rayon::prelude::*;
-use serde_json::{json, Value};
 use squeal_core::EventKind;
 use squeal_plot::{Colormap, Format, HeatmapSpec};
 use squeal_study::model::AnyModel;
@@ -75,61 +74,7 @@ pub struct ReproduceArgs {
 
 use crate::commands::merge::{reproduce_study, write_reproduce_part, Shard};
 use squeal_study::reproduce::*;
-use squeal_study::run::run_many;
-use squeal_study::NoProgress;
 use squeal_study::Scenario;
-
-fn opt(x: Option<f64>, prec: usize) -> String {
-    x.filter(|v| v.is_finite())
-        .map_or(String::new(), |v| format!("{v:.prec$}"))
-}
-
-/// The parameters the table shows for every set (the ones the sets vary).
-const TABLE_PARAMS: [&str; 8] = ["V", "N", "f1", "alpha", "c_dx", "c_dy", "c_px", "c_py"];
-
-const TABLE_HEADER: &str = "set,question,V,N,f1,alpha,c_dx,c_dy,c_px,c_py,duration,linear,max_growth_rate,least_stable_hz,verdict,tangential_hz,normal_hz,growth_rate_vx_p,growth_rate_vx_d,stick_fraction,reversals,sticks,tangential_zero,agree,squeal_coordinate,squeal_frequency_hz,squeal_level_db,separations,valid,erp_db,spl_dba";
-
-fn table_csv(rs: &[SetResult]) -> String {
-    let mut t = String::from(TABLE_HEADER);
-    t.push('\n');
-    for r in rs {
-        let q = r.sc.description.replace('"', "'");
-        let params: Vec<String> = TABLE_PARAMS.iter().map(|k| r.p(k).to_string()).collect();
-        let _ = writeln!(
-            t,
-            "{},\"{}\",{},{},{},{},{},{},{},{},{},{},{:e},{},{},{},{},{},{},{},{},{},{},{}",
-            r.id,
-            q,
-            params.join(","),
-            r.sc.duration,
-            r.linear_word(),
-            r.linear
-                .as_ref()
-                .map_or(String::new(), |l| format!("{:e}", l.max_growth)),
-            r.linear
-                .as_ref()
-                .map_or(String::new(), |l| format!("{:.2}", l.freq_hz)),
-            r.verdict,
-            opt(r.f_t, 2),
-            opt(r.f_n, 2),
-            opt(r.growth_of("vx_p"), 4),
-            opt(r.growth_of("vx_d"), 4),
-            r.stick_fraction,
-            r.events[EventKind::Reverse.index()],
-            r.events[EventKind::Stick.index()],
-            r.tangential_zero,
-            r.agrees().map_or("", |a| if a { "yes" } else { "no" }),
-            r.squeal.as_ref().map_or("", |s| s.coordinate.as_str()),
-            opt(r.squeal.as_ref().map(|s| s.frequency_hz), 2),
-            opt(r.squeal.as_ref().map(|s| s.level_db), 2),
-            r.events[EventKind::Separate.index()],
-            r.outside().is_none(),
-            opt(r.erp_db, 2),
-            opt(r.spl_dba, 2),
-        );
-    }
-    t
-}
 
 /// "0.5 s (sets 1–14), 1 s (…)": the durations used, grouped.
 fn durations(rs: &[SetResult]) -> String {
@@ -833,13 +778,9 @@ fn draw_map(rs: &[SetResult], dir: &Path) -> Result<String, RunError> {
     Ok(note)
 }
 
-/// Measure the sets `ids` (indices into `sets`, set `i + 1`) in parallel,
-/// drawing Appendix A's pictures into `figures` if given; results in the
-/// order of `ids`, whatever the number of threads. Each task takes up to
-/// four sets ([`squeal_study::run::tasks`]: fewer when their series would
-/// take too much memory together) and runs them together on its core
-/// ([`run_many`]: the disc–pads as one ensemble, bit for bit their single
-/// runs), then analyses each.
+/// Measure the sets `ids` (indices into `sets`, set `i + 1`) in parallel
+/// ([`squeal_study::reproduce::measure_sets`]), drawing Appendix A's
+/// pictures into `figures` if given; results in the order of `ids`.
 fn measure_sets(
     sets: &[Scenario],
     ids: &[usize],
@@ -847,34 +788,19 @@ fn measure_sets(
     label: &str,
 ) -> Result<Vec<SetResult>, RunError> {
     let pb = progress_bar(ids.len() as u64, label);
-    let all: Vec<&Scenario> = ids.iter().map(|&i| &sets[i]).collect();
-    let results: Vec<Vec<Result<SetResult, RunError>>> = squeal_study::run::tasks(&all)
-        .into_par_iter()
-        .map(|task| {
-            let chunk = &ids[task.clone()];
-            let scs = &all[task];
-            let runs = run_many(scs, &NoProgress, &NEVER);
-            chunk
-                .iter()
-                .zip(runs)
-                .map(|(&i, run)| {
-                    let sc = sets[i].clone();
-                    let ch = sc.model.channels();
-                    let r = run.map_err(RunError::from).and_then(|run| {
-                        measure_run(i + 1, sc, run, |run, an, answer| {
-                            draw_set(i + 1, run, an, answer, &ch, figures)
-                        })
-                    });
-                    squeal_study::Progress::inc(&pb, 1);
-                    r
-                })
-                .collect()
-        })
-        .collect();
-    squeal_study::Progress::finish(&pb);
+    let results = squeal_study::reproduce::measure_sets(
+        sets,
+        ids,
+        |id, run, an, answer| {
+            let ch = sets[id - 1].model.channels();
+            draw_set(id, run, an, answer, &ch, figures)
+        },
+        &pb,
+        &NEVER,
+    );
     let mut rs = Vec::with_capacity(ids.len());
-    for (i, r) in ids.iter().zip(results.into_iter().flatten()) {
-        rs.push(r.map_err(|e| RunError::Numerical(format!("set {}: {e}", i + 1)))?);
+    for (i, r) in ids.iter().zip(results) {
+        rs.push(r.map_err(|e: RunError| RunError::Numerical(format!("set {}: {e}", i + 1)))?);
     }
     Ok(rs)
 }
@@ -899,10 +825,7 @@ pub fn finish(
             .map_err(|e| RunError::Io(format!("cannot write {}: {e}", p.display())))
     };
     write("table.csv", &table_csv(rs))?;
-    let cj: Vec<Value> = cs
-        .iter()
-        .map(|c| json!({ "id": c.id, "thesis": c.thesis, "claim": c.claim, "held": c.grade.held(), "grade": c.grade.as_str(), "caveat": c.caveat, "evidence": c.evidence, "data": c.data }))
-        .collect();
+    let cj = conclusions_json(&cs);
     write(
         "conclusions.json",
         &(serde_json::to_string_pretty(&cj).map_err(|e| RunError::Io(e.to_string()))? + "\n"),
