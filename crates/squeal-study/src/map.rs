@@ -300,13 +300,12 @@ fn watch_for<M: System<N>, const N: usize>(
     sc: &Scenario,
 ) -> Result<(Watch, [f64; N]), String> {
     let names = model.names();
-    let mut idx: Vec<usize> = (N / 2..N)
-        .filter(|&i| names[i].starts_with("vx") || names[i] == "v")
-        .collect();
-    if idx.is_empty() {
-        // A lumped model whose dofs are not named x_…, an FE model's
-        // `6_1` say: the velocities of its contacts' tangential dofs.
-        if let AnyModel::Lumped(l) = &sc.model {
+    // The tangential velocities: a lumped model's are those of its
+    // contacts' tangential dofs (whatever the dofs are called: `x_d`, or an
+    // FE model's `6_1`); a built-in's are named `vx…` (`v` for the belt).
+    let idx: Vec<usize> = match &sc.model {
+        AnyModel::Lumped(l) => {
+            let mut idx = Vec::new();
             for c in &l.contacts {
                 for &i in &c.tangent.idx {
                     if N / 2 + i < N && !idx.contains(&(N / 2 + i)) {
@@ -314,8 +313,12 @@ fn watch_for<M: System<N>, const N: usize>(
                     }
                 }
             }
+            idx
         }
-    }
+        _ => (N / 2..N)
+            .filter(|&i| names[i].starts_with("vx") || names[i] == "v")
+            .collect(),
+    };
     let v_idx = *idx.first().ok_or("no tangential velocity")?;
     let z0 = crate::run::initial_of(model, sc).map_err(|e| e.to_string())?;
     let window = sc.duration / 50.0;

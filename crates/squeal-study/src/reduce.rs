@@ -92,14 +92,6 @@ impl Reduction {
     }
 }
 
-fn dense(s: &squeal_core::model::lumped::Sparse) -> DMatrix<f64> {
-    let mut d = DMatrix::zeros(s.n, s.n);
-    for (r, c, v) in s.entries() {
-        d[(r, c)] += v;
-    }
-    d
-}
-
 fn triplets(a: &DMatrix<f64>) -> Triplets {
     let mut entries = Vec::new();
     for c in 0..a.ncols() {
@@ -202,7 +194,7 @@ pub fn reduce(sc: &Scenario) -> Result<Reduction, StudyError> {
     } else {
         Basis::CutoffHz(l.modal.cutoff_hz)
     };
-    let (md, kd) = (dense(m), dense(k));
+    let (md, kd) = (m.to_dense(), k.to_dense());
     let cb: CraigBampton = craig_bampton(&md, &kd, &boundary, basis)
         .map_err(|e| InputError(format!("reduce: {e}")))?;
     let nm = cb.omega2.len();
@@ -282,7 +274,7 @@ pub fn reduce(sc: &Scenario) -> Result<Reduction, StudyError> {
         shifted: cb.shifted,
         m: triplets(&reduced(&cb, &md)),
         k: triplets(&reduced(&cb, &kd)),
-        c: c.map(|c| triplets(&reduced(&cb, &dense(c)))),
+        c: c.map(|c| triplets(&reduced(&cb, &c.to_dense()))),
         toml,
     })
 }

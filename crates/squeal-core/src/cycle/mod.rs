@@ -565,25 +565,39 @@ pub fn settle<S: System<N> + ?Sized, const N: usize>(
                 list.remove(0);
             }
             if let Some(found) = periodic(list, opts, n, sec.index) {
-                let (mut a, mut b) = (seg.t0, seg.t1);
-                for _ in 0..200 {
-                    let m = 0.5 * (a + b);
-                    if m <= a || m >= b {
-                        break;
-                    }
-                    if solver.dense_at(m)[sec.index] - sec.level < 0.0 {
-                        a = m;
-                    } else {
-                        b = m;
-                    }
-                }
-                let mut z_start = solver.dense_at(b);
-                z_start[sec.index] = sec.level;
+                let (_, z_start) = upward_crossing(&solver, seg.t0, seg.t1, *sec);
                 return Ok((*sec, z_start, found, solver.t() - t0));
             }
         }
         prev = if seg.switched { *solver.state() } else { z1 };
     }
+}
+
+/// The upward crossing of `section` within the last step `[t0, t1]` of
+/// `solver` (the state is below the level at `t0`, at or above it at `t1`),
+/// by bisection on the dense output to the last bit of `t`: the time and the
+/// state there, its section component set to the level exactly.
+fn upward_crossing<S: System<N> + ?Sized, const N: usize>(
+    solver: &Solver<'_, S, N>,
+    t0: f64,
+    t1: f64,
+    section: Section,
+) -> (f64, [f64; N]) {
+    let (mut a, mut b) = (t0, t1);
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if m <= a || m >= b {
+            break;
+        }
+        if solver.dense_at(m)[section.index] - section.level < 0.0 {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    let mut z = solver.dense_at(b);
+    z[section.index] = section.level;
+    (b, z)
 }
 
 fn not_settled_cause<const N: usize>(returns: &[Vec<Return<N>>]) -> String {
@@ -1048,21 +1062,7 @@ pub fn section_returns<S: System<N> + ?Sized, const N: usize>(
     while let Some(seg) = sol.step()? {
         let z1 = sol.dense_at(seg.t1);
         if prev[k] - section.level < 0.0 && z1[k] - section.level >= 0.0 {
-            let (mut a, mut b) = (seg.t0, seg.t1);
-            for _ in 0..200 {
-                let m = 0.5 * (a + b);
-                if m <= a || m >= b {
-                    break;
-                }
-                if sol.dense_at(m)[k] - section.level < 0.0 {
-                    a = m;
-                } else {
-                    b = m;
-                }
-            }
-            let mut z = sol.dense_at(b);
-            z[k] = section.level;
-            out.push((b, z));
+            out.push(upward_crossing(&sol, seg.t0, seg.t1, section));
         }
         prev = if seg.switched { *sol.state() } else { z1 };
     }

@@ -136,6 +136,14 @@ impl Sparse {
             (self.row_ptr[r]..self.row_ptr[r + 1]).map(move |k| (r, self.col[k], self.val[k]))
         })
     }
+    /// The same matrix, dense.
+    pub fn to_dense(&self) -> DMatrix<f64> {
+        let mut d = DMatrix::<f64>::zeros(self.n, self.n);
+        for (r, c, v) in self.entries() {
+            d[(r, c)] += v;
+        }
+        d
+    }
     /// Whether only diagonal entries are non-zero.
     pub fn is_diagonal(&self) -> bool {
         self.entries().all(|(r, c, _)| r == c)
@@ -1395,12 +1403,10 @@ impl Lumped {
         let n = self.dofs.len();
         let modes = self.sliding_modes_at(z);
         let jf = self.force_jacobian(&modes, z);
-        let mut m = DMatrix::<f64>::zeros(n, n);
-        if let Some(mm) = &self.m_matrix {
-            for (r, c, v) in mm.entries() {
-                m[(r, c)] += v;
-            }
-        }
+        let mut m = self
+            .m_matrix
+            .as_ref()
+            .map_or_else(|| DMatrix::<f64>::zeros(n, n), Sparse::to_dense);
         for i in 0..n {
             m[(i, i)] += self.masses[i];
         }

@@ -57,13 +57,6 @@ impl CraigBampton {
     pub fn project(&self, a: &DMatrix<f64>) -> DMatrix<f64> {
         self.t.transpose() * (a * &self.t)
     }
-
-    /// The highest fixed-interface mode kept (Hz), `None` with none kept.
-    pub fn max_hz(&self) -> Option<f64> {
-        self.omega2
-            .last()
-            .map(|w2| w2.max(0.0).sqrt() / std::f64::consts::TAU)
-    }
 }
 
 /// The Craig–Bampton basis of `(M, K)` with `boundary` kept physical and the

@@ -431,32 +431,42 @@ pub fn craig_bampton_basis(
     sys: &SecondOrder,
     basis: Basis,
 ) -> Result<UndampedBasis, StabilityError> {
+    let cb = super::craig_bampton::craig_bampton(&sys.m, &sys.k, &coupling_dofs(sys), basis)?;
+    ritz_basis(sys, &cb, cb.omega2.len())
+}
+
+/// The `M`-orthonormal Ritz basis of the span of `cb`'s constraint modes
+/// and its `modes` lowest fixed-interface modes ([`craig_bampton_basis`]).
+fn ritz_basis(
+    sys: &SecondOrder,
+    cb: &super::craig_bampton::CraigBampton,
+    modes: usize,
+) -> Result<UndampedBasis, StabilityError> {
     let n = check(sys)?;
-    let boundary = coupling_dofs(sys);
-    let cb = super::craig_bampton::craig_bampton(&sys.m, &sys.k, &boundary, basis)?;
-    let r = cb.t.ncols();
+    let nb = cb.boundary.len();
+    let r = nb + modes;
     if r == 0 {
         return Err(StabilityError::BadInput(
             "Craig–Bampton basis: no contact dof and no fixed-interface mode below modal.cutoff_hz"
                 .into(),
         ));
     }
+    let t = cb.t.columns(0, r).into_owned();
+    let project = |a: &DMatrix<f64>| t.transpose() * (a * &t);
     let ks = DMatrix::from_fn(n, n, |i, j| 0.5 * (sys.k[(i, j)] + sys.k[(j, i)]));
     let small = SecondOrder {
-        m: cb.project(&sys.m),
-        k: cb.project(&ks),
+        m: project(&sys.m),
+        k: project(&ks),
         c: DMatrix::zeros(r, r),
     };
     let ritz = undamped_basis(&small, Basis::Modes(r))?;
-    let t = to_faer(&cb.t);
-    let phi = &t * &ritz.phi;
-    let nb = boundary.len();
-    let mut omega2 = cb.omega2.clone();
-    omega2.extend(ritz.omega2[r - nb.min(r)..].iter().copied());
+    let phi = &to_faer(&t) * &ritz.phi;
+    let mut omega2 = cb.omega2[..modes].to_vec();
+    omega2.extend(ritz.omega2[r - nb..].iter().copied());
     Ok(UndampedBasis {
         phi,
         omega2,
-        static_vectors: nb.min(r),
+        static_vectors: nb,
     })
 }
 
@@ -533,13 +543,13 @@ fn upper_eigenvalues(a: &DMatrix<f64>) -> Result<Vec<Complex<f64>>, StabilityErr
 
 /// [`truncation_table`] of a Craig–Bampton basis: a quarter, half, three
 /// quarters and all of its fixed-interface modes (the contact dofs in every
-/// row; the interior's modes are recomputed for each).
+/// row; the interior's modes computed once, a Ritz solve per row).
 fn craig_bampton_truncation(
     sys: &SecondOrder,
     basis: Basis,
 ) -> Result<Vec<Truncation>, StabilityError> {
-    let full = craig_bampton_basis(sys, basis)?;
-    let m = full.phi.ncols() - full.static_vectors;
+    let cb = super::craig_bampton::craig_bampton(&sys.m, &sys.k, &coupling_dofs(sys), basis)?;
+    let m = cb.omega2.len();
     let mut counts: Vec<usize> = [1usize, 2, 3, 4]
         .iter()
         .map(|q| (m * q).div_ceil(4))
@@ -548,15 +558,11 @@ fn craig_bampton_truncation(
     counts
         .into_iter()
         .map(|k| {
-            let b = if k == m {
-                full.clone()
-            } else {
-                craig_bampton_basis(sys, Basis::Modes(k))?
-            };
+            let b = ritz_basis(sys, &cb, k)?;
             let a = reduced_state_matrix(sys, &b);
             Ok(Truncation {
                 modes: k,
-                basis_max_hz: b.omega2[..k].last().map_or(0.0, |w2| w2.max(0.0).sqrt())
+                basis_max_hz: cb.omega2[..k].last().map_or(0.0, |w2| w2.max(0.0).sqrt())
                     / std::f64::consts::TAU,
                 static_vectors: b.static_vectors,
                 eigenvalues: upper_eigenvalues(&a)?,
