@@ -121,3 +121,73 @@ pub struct SecondOrder {
     /// Damping (`−∂force/∂q̇`), any symmetry.
     pub c: DMatrix<f64>,
 }
+
+/// Models with more dofs than this that are analysed by projection keep
+/// their matrices sparse from the file to the solver
+/// ([`SparseSecondOrder`]; the real modes by block shift-invert Lanczos,
+/// `stability::lanczos`): a dense solve of their real modes would take
+/// `9 n³` flops (a minute at 2000 dofs) and `8 n²` bytes.
+pub const SPARSE_FROM_DOFS: usize = 2000;
+
+/// The linearised second-order system `M q̈ + C q̇ + K q = 0` with sparse
+/// matrices (compressed columns, both triangles stored): what a
+/// large FE model linearises to (its matrices plus a few contact terms).
+#[derive(Debug, Clone)]
+pub struct SparseSecondOrder {
+    /// Mass matrix (symmetric positive definite).
+    pub m: faer::sparse::SparseColMat<usize, f64>,
+    /// Stiffness (`−∂force/∂q`), any symmetry.
+    pub k: faer::sparse::SparseColMat<usize, f64>,
+    /// Damping (`−∂force/∂q̇`), any symmetry.
+    pub c: faer::sparse::SparseColMat<usize, f64>,
+}
+
+impl SparseSecondOrder {
+    /// From `(row, col, value)` triplets of an `n × n` system (duplicates
+    /// summed). `None` if an index is out of range.
+    pub fn from_triplets(
+        n: usize,
+        m: &[(usize, usize, f64)],
+        k: &[(usize, usize, f64)],
+        c: &[(usize, usize, f64)],
+    ) -> Option<SparseSecondOrder> {
+        let build = |t: &[(usize, usize, f64)]| {
+            let t: Vec<faer::sparse::Triplet<usize, usize, f64>> = t
+                .iter()
+                .map(|&(i, j, v)| faer::sparse::Triplet::new(i, j, v))
+                .collect();
+            faer::sparse::SparseColMat::try_new_from_triplets(n, n, &t).ok()
+        };
+        Some(SparseSecondOrder {
+            m: build(m)?,
+            k: build(k)?,
+            c: build(c)?,
+        })
+    }
+    /// Number of dofs.
+    pub fn dofs(&self) -> usize {
+        self.m.nrows()
+    }
+    /// Stored entries of `K` (the size of the problem).
+    pub fn nonzeros(&self) -> usize {
+        self.k.compute_nnz()
+    }
+    /// The same system with dense matrices.
+    pub fn to_dense(&self) -> SecondOrder {
+        let n = self.dofs();
+        let dense = |a: &faer::sparse::SparseColMat<usize, f64>| {
+            let mut d = DMatrix::<f64>::zeros(n, n);
+            for j in 0..n {
+                for (i, &v) in a.row_idx_of_col(j).zip(a.val_of_col(j)) {
+                    d[(i, j)] += v;
+                }
+            }
+            d
+        };
+        SecondOrder {
+            m: dense(&self.m),
+            k: dense(&self.k),
+            c: dense(&self.c),
+        }
+    }
+}

@@ -22,7 +22,10 @@ pub const MAX_SERIES_BYTES: f64 = 1024.0 * 1024.0 * 1024.0;
 /// about 2.4 bytes per series byte above a fixed 0.2 GB; 3 leaves a margin.
 pub const RUN_MEMORY_PER_SERIES_BYTE: f64 = 3.0;
 
-pub use crate::memory::{check_model_memory, dense_analysis_bytes, MEMORY_CHECK_FROM};
+pub use crate::memory::{
+    analysis_bytes, check_model_memory, dense_analysis_bytes, sparse_analysis_bytes,
+    MEMORY_CHECK_FROM,
+};
 
 /// Most steps a run may need at the least (its [`min_steps`]): beyond this
 /// it would run for minutes (about 1 µs per step, and an accurate run takes

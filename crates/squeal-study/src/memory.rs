@@ -115,16 +115,44 @@ pub fn dense_analysis_bytes(n: usize) -> f64 {
     300.0 * (n as f64) * (n as f64)
 }
 
-/// Refuse a lumped model whose dense analyses would not fit the memory
-/// this process may take, before anything is sized from its dof count.
-pub fn check_model_memory(dofs: usize) -> Result<(), crate::error::InputError> {
-    let need = dense_analysis_bytes(dofs);
-    if need > MEMORY_CHECK_FROM {
-        check(
-            need,
-            &format!("a lumped model of {dofs} dofs (its dense steady-sliding and eigen-analysis)"),
+/// Memory of the sparse analysis of a lumped model with `n` dofs and
+/// `nonzeros` stored matrix entries (bytes): the Lanczos vectors and their
+/// `M` products (`16 n` per vector, a few hundred vectors), the sparse
+/// factorisation's fill (taken as 40 entries of 12 bytes per nonzero) and
+/// the kept eigenvectors
+/// ([`squeal_core::stability::projected::VECTOR_BUDGET`]).
+pub fn sparse_analysis_bytes(n: usize, nonzeros: usize) -> f64 {
+    let vectors = 16.0 * n as f64 * 400.0;
+    let factor = 480.0 * nonzeros as f64;
+    let kept = 16.0 * squeal_core::stability::projected::VECTOR_BUDGET as f64;
+    vectors + factor + kept
+}
+
+/// The memory an analysis of a lumped model of `dofs` dofs and `nonzeros`
+/// stored matrix entries takes (bytes) and what it is: sparse above
+/// [`squeal_core::linear::SPARSE_FROM_DOFS`] dofs, dense below.
+pub fn analysis_bytes(dofs: usize, nonzeros: usize) -> (f64, &'static str) {
+    if dofs > squeal_core::linear::SPARSE_FROM_DOFS {
+        (
+            sparse_analysis_bytes(dofs, nonzeros),
+            "its sparse steady-sliding and eigen-analysis",
         )
-        .map_err(crate::error::InputError)?;
+    } else {
+        (
+            dense_analysis_bytes(dofs),
+            "its dense steady-sliding and eigen-analysis",
+        )
+    }
+}
+
+/// Refuse a lumped model whose analyses would not fit the memory this
+/// process may take ([`analysis_bytes`]), before anything is sized from
+/// its dof count.
+pub fn check_model_memory(dofs: usize, nonzeros: usize) -> Result<(), crate::error::InputError> {
+    let (need, what) = analysis_bytes(dofs, nonzeros);
+    if need > MEMORY_CHECK_FROM {
+        check(need, &format!("a lumped model of {dofs} dofs ({what})"))
+            .map_err(crate::error::InputError)?;
     }
     Ok(())
 }

@@ -45,6 +45,9 @@ pub fn plan(sc: &Scenario, command: &str, points: usize) -> Option<String> {
         )
     } else {
         match l.modal.kind {
+            BasisKind::Modes if n > squeal_core::linear::SPARSE_FROM_DOFS => format!(
+                "steady sliding, the real modes {basis} by sparse block shift-invert Lanczos, kept with the static correction at the contact dofs, then the projected complex eigenproblem"
+            ),
             BasisKind::Modes => format!(
                 "steady sliding, the real modes of all {n} dofs (a dense symmetric eigen-solve), {basis} kept with the static correction at the contact dofs, then the projected complex eigenproblem"
             ),
@@ -53,7 +56,8 @@ pub fn plan(sc: &Scenario, command: &str, points: usize) -> Option<String> {
             ),
         }
     };
-    let mb = crate::memory::dense_analysis_bytes(n) / 1e6;
+    let nonzeros = sc.matrices.info.iter().map(|i| i.nonzeros).sum();
+    let mb = crate::memory::analysis_bytes(n, nonzeros).0 / 1e6;
     let times = if points > 1 {
         format!(", {points} times")
     } else {

@@ -304,7 +304,8 @@ impl Scenario {
         let lumped = model_name == "lumped";
         let model = if lumped {
             let (l, files) = crate::lumped_file::parse(table, base)?;
-            crate::memory::check_model_memory(l.dof_count())?;
+            let nonzeros = files.info.iter().map(|i| i.nonzeros).sum();
+            crate::memory::check_model_memory(l.dof_count(), nonzeros)?;
             matrices = files;
             AnyModel::Lumped(Box::new(l))
         } else {

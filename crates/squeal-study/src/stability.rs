@@ -11,6 +11,12 @@ use squeal_core::stability::{Analysis, StabilityError};
 /// How mode shapes are normalised (stated in the JSON and the README).
 pub const SHAPE_NORMALISATION: &str = "position part of the eigenvector divided by its largest component: that dof has amplitude 1 and phase 0, every amplitude is in [0, 1], phases in degrees in (-180, 180]";
 
+/// The JSON lists every mode's shape when dofs × modes is at most this
+/// (a few MB of JSON); above, only the growing modes' and the least stable
+/// one's (`"shapes": "growing and least stable"`; the others' `shape` is
+/// empty): a 10⁵-dof brake's hundreds of modes would be gigabytes.
+pub const SHAPE_ENTRIES_MAX: usize = 200_000;
+
 /// Amplitude and phase (degrees) of every position dof of a mode.
 pub fn shape_of(e: &squeal_core::stability::Eigen) -> Vec<(f64, f64)> {
     use squeal_core::stability::modal::{amplitude_phase, mode_shape};
@@ -30,6 +36,7 @@ pub fn analyse(model: &AnyModel) -> Result<Analysis, StabilityError> {
 /// `modal.dense_max_dofs` dofs, the projection basis above), and the
 /// contact dofs where it moves most (amplitude relative to its largest).
 pub fn coupled_modes(model: &AnyModel, an: &Analysis) -> Vec<CoupledMode> {
+    use nalgebra::Complex;
     use squeal_core::model::contact::Normal;
     use squeal_core::stability::projected::{undamped_basis, Basis};
     let AnyModel::Lumped(l) = model else {
@@ -42,7 +49,6 @@ pub fn coupled_modes(model: &AnyModel, an: &Analysis) -> Vec<CoupledMode> {
     if growing.is_empty() {
         return Vec::new();
     }
-    let sys = l.second_order_dyn(&an.equilibrium);
     // The real modes: the structure at steady sliding (its closed contacts'
     // normal stiffness) without friction, whose symmetric half can make
     // the stiffness indefinite when μ·k_contact exceeds the structure's
@@ -50,14 +56,45 @@ pub fn coupled_modes(model: &AnyModel, an: &Analysis) -> Vec<CoupledMode> {
     let Ok(free) = crate::inspect::frictionless(l) else {
         return Vec::new();
     };
-    let free_sys = free.second_order_dyn(&an.equilibrium);
     let basis = if l.modal.projects(n) {
         l.modal.basis()
     } else {
         Basis::Modes(n)
     };
-    let Ok(basis) = undamped_basis(&free_sys, basis) else {
-        return Vec::new();
+    // `M q` of a mode shape, and the real modes.
+    type MassTimes = Box<dyn Fn(&[Complex<f64>]) -> Vec<Complex<f64>>>;
+    let (mass_times, basis): (MassTimes, _) = if squeal_core::stability::lumped::sparse(l) {
+        use squeal_core::stability::projected::Structure;
+        let sys = free.second_order_sparse(&an.equilibrium);
+        let Ok(b) = sys.undamped(basis) else {
+            return Vec::new();
+        };
+        let m = sys.m;
+        let times = move |q: &[Complex<f64>]| {
+            let x = faer::Mat::<f64>::from_fn(
+                q.len(),
+                2,
+                |i, j| if j == 0 { q[i].re } else { q[i].im },
+            );
+            let y = squeal_core::stability::lanczos::sparse_mul(m.as_ref(), x.as_ref());
+            (0..q.len())
+                .map(|i| Complex::new(y[(i, 0)], y[(i, 1)]))
+                .collect()
+        };
+        (Box::new(times), b)
+    } else {
+        let sys = free.second_order_dyn(&an.equilibrium);
+        let Ok(b) = undamped_basis(&sys, basis) else {
+            return Vec::new();
+        };
+        let m = sys.m;
+        let times = move |q: &[Complex<f64>]| {
+            let n = q.len();
+            (0..n)
+                .map(|i| (0..n).fold(Complex::new(0.0, 0.0), |s, j| s + q[j] * m[(i, j)]))
+                .collect()
+        };
+        (Box::new(times), b)
     };
     let mut contact_dofs: Vec<usize> = Vec::new();
     for c in &l.contacts {
@@ -87,8 +124,12 @@ pub fn coupled_modes(model: &AnyModel, an: &Analysis) -> Vec<CoupledMode> {
             at.truncate(3);
             CoupledMode {
                 eigenvalue: i,
-                composition: squeal_core::stability::coupling::composition(
-                    &sys.m, &basis, q, 0.01, 5,
+                composition: squeal_core::stability::coupling::composition_of(
+                    &mass_times(q),
+                    &basis,
+                    q,
+                    0.01,
+                    5,
                 ),
                 contact_dofs: at,
             }
@@ -129,13 +170,18 @@ pub fn coupled_json(an: &Analysis, c: &[CoupledMode]) -> Value {
 /// The JSON document of an analysis.
 pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
     let names = model.state_names();
+    let dofs = names.len() / 2;
+    let all_shapes = dofs * an.eigen.len() <= SHAPE_ENTRIES_MAX;
     let eig: Vec<Value> = an
         .eigen
         .iter()
-        .map(|e| {
+        .enumerate()
+        .map(|(i, e)| {
+            let with_shape = all_shapes || e.growing || i == an.least_stable;
             let shape: Vec<Value> = shape_of(e)
                 .into_iter()
                 .enumerate()
+                .take(if with_shape { usize::MAX } else { 0 })
                 .map(|(i, (a, p))| json!({ "dof": names.get(i).map_or("", String::as_str), "amplitude": a, "phase_deg": p }))
                 .collect();
             json!({
@@ -161,6 +207,7 @@ pub fn analysis_json(model: &AnyModel, an: &Analysis) -> Value {
         "least_stable": { "re": ls.re, "im": ls.im, "freq_hz": ls.freq_hz, "dominant": ls.dominant_name },
         "equilibrium": eq,
         "shape_normalisation": SHAPE_NORMALISATION,
+        "shapes": if all_shapes { "all" } else { "growing and least stable" },
         "modal": modal_json(an),
         "coupled_modes": coupled_json(an, &coupled_modes(model, an)),
     })

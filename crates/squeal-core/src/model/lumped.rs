@@ -38,7 +38,7 @@ use super::{
     EventKind, Guard, GuardKind, Guards, Mode, ModelError, Modes, Observables, System, MAX_CONTACTS,
 };
 use crate::friction::FrictionLaw;
-use crate::linear::{ModalOptions, SecondOrder};
+use crate::linear::{ModalOptions, SecondOrder, SparseSecondOrder, SPARSE_FROM_DOFS};
 use crate::params::ParamError;
 use nalgebra::DMatrix;
 
@@ -271,11 +271,34 @@ pub struct LumpedSpec {
     pub expressions: Vec<(String, String)>,
 }
 
-/// `M⁻¹`: diagonal, or dense row-major.
+/// `M⁻¹`: diagonal, dense row-major, or (a large model's non-diagonal
+/// `M`, more than [`SPARSE_FROM_DOFS`] dofs) a sparse Cholesky factor of
+/// `M` (a dense inverse would take `n³/3` flops and `8 n²` bytes).
 #[derive(Debug, Clone, PartialEq)]
 enum InvMass {
     Diagonal(Vec<f64>),
     Dense(Vec<f64>),
+    Factored(MassFactor),
+}
+
+/// The sparse Cholesky factor of a large model's `M` ([`InvMass`]). Two
+/// factors compare equal: they are derived from the mass matrices, which
+/// the model compares itself.
+#[derive(Debug, Clone)]
+struct MassFactor(std::sync::Arc<faer::sparse::linalg::solvers::Llt<usize, f64>>);
+
+impl PartialEq for MassFactor {
+    fn eq(&self, _: &MassFactor) -> bool {
+        true
+    }
+}
+
+impl MassFactor {
+    /// `X ← M⁻¹ X`.
+    fn solve_in_place(&self, x: faer::MatMut<'_, f64>) {
+        use faer::linalg::solvers::Solve;
+        self.0.solve_in_place(x);
+    }
 }
 
 /// A lumped model (see the module docs). Build it with [`Lumped::build`].
@@ -779,6 +802,27 @@ impl Lumped {
         let n = self.dofs.len();
         self.has_ramp = self.forces.iter().any(|f| f.ramp > 0.0);
         self.inv_mass = match &self.m_matrix {
+            Some(m) if !m.is_diagonal() && n > SPARSE_FROM_DOFS => {
+                let mut t: Vec<faer::sparse::Triplet<usize, usize, f64>> = m
+                    .entries()
+                    .map(|(r, c, v)| faer::sparse::Triplet::new(r, c, v))
+                    .collect();
+                t.extend(
+                    (0..n)
+                        .filter(|&i| self.masses[i] != 0.0)
+                        .map(|i| faer::sparse::Triplet::new(i, i, self.masses[i])),
+                );
+                let not_pd = || {
+                    SpecError(
+                        "matrices: M (with the [masses] added) is not positive definite".into(),
+                    )
+                };
+                let full =
+                    faer::sparse::SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t)
+                        .map_err(|_| not_pd())?;
+                let llt = full.sp_cholesky(faer::Side::Lower).map_err(|_| not_pd())?;
+                InvMass::Factored(MassFactor(std::sync::Arc::new(llt)))
+            }
             Some(m) if !m.is_diagonal() => {
                 let mut full = DMatrix::from_fn(n, n, |r, c| m.get(r, c));
                 for i in 0..n {
@@ -950,6 +994,13 @@ impl Lumped {
                 for r in 0..n {
                     let row = &inv[r * n..(r + 1) * n];
                     out[r] = row.iter().zip(x).map(|(a, b)| a * b).sum();
+                }
+            }
+            InvMass::Factored(f) => {
+                let mut v = faer::Mat::<f64>::from_fn(x.len(), 1, |i, _| x[i]);
+                f.solve_in_place(v.as_mut());
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = v[(i, 0)];
                 }
             }
         }
@@ -1235,24 +1286,37 @@ impl Lumped {
     /// analytic Jacobian of the force (see the module docs).
     fn force_jacobian(&self, modes: &Modes, z: &[f64]) -> DMatrix<f64> {
         let n = self.dofs.len();
-        let (q, u) = z.split_at(n);
         let mut j = DMatrix::<f64>::zeros(n, 2 * n);
+        self.force_jacobian_terms(modes, z, &mut |r, c, v| j[(r, c)] += v);
+        j
+    }
+
+    /// The terms of [`Lumped::force_jacobian`], each `(row, col, value)`
+    /// (repeated positions add up) to `add`.
+    fn force_jacobian_terms(
+        &self,
+        modes: &Modes,
+        z: &[f64],
+        add: &mut dyn FnMut(usize, usize, f64),
+    ) {
+        let n = self.dofs.len();
+        let (q, u) = z.split_at(n);
         for s in &self.springs {
             for (a, ca) in s.on.idx.iter().zip(&s.on.coef) {
                 for (b, cb) in s.on.idx.iter().zip(&s.on.coef) {
-                    j[(*a, *b)] -= s.k * ca * cb;
-                    j[(*a, n + *b)] -= s.c * ca * cb;
+                    add(*a, *b, -(s.k * ca * cb));
+                    add(*a, n + *b, -(s.c * ca * cb));
                 }
             }
         }
         if let Some(k) = &self.k_matrix {
             for (r, c, v) in k.entries() {
-                j[(r, c)] -= v;
+                add(r, c, -(v));
             }
         }
         if let Some(cm) = &self.c_matrix {
             for (r, c, v) in cm.entries() {
-                j[(r, n + c)] -= v;
+                add(r, n + c, -(v));
             }
         }
         for (i, c) in self.contacts.iter().enumerate() {
@@ -1274,7 +1338,7 @@ impl Lumped {
                 // −F_n·n
                 for (a, ca) in normal.idx.iter().zip(&normal.coef) {
                     for (col, g) in g_n.iter().enumerate() {
-                        j[(*a, col)] -= ca * g;
+                        add(*a, col, -(ca * g));
                     }
                 }
             }
@@ -1305,7 +1369,7 @@ impl Lumped {
             }
             for (a, ca) in c.tangent.idx.iter().zip(&c.tangent.coef) {
                 for (col, g) in g_t.iter().enumerate() {
-                    j[(*a, col)] -= ca * g;
+                    add(*a, col, -(ca * g));
                 }
             }
             if c.alpha != 0.0 {
@@ -1318,13 +1382,12 @@ impl Lumped {
                     }
                     for (a, ca) in normal.idx.iter().zip(&normal.coef) {
                         for (col, g) in g_f.iter().enumerate() {
-                            j[(*a, col)] += ca * g;
+                            add(*a, col, ca * g);
                         }
                     }
                 }
             }
         }
-        j
     }
 
     /// The state matrix `∂f/∂z` (2n × 2n) of the sliding equations at `z`.
@@ -1343,6 +1406,15 @@ impl Lumped {
             InvMass::Dense(inv) => {
                 let minv = DMatrix::from_row_slice(n, n, inv);
                 a.view_mut((n, 0), (n, 2 * n)).copy_from(&(minv * &jf));
+            }
+            InvMass::Factored(f) => {
+                let mut x = faer::Mat::<f64>::from_fn(n, 2 * n, |r, c| jf[(r, c)]);
+                f.solve_in_place(x.as_mut());
+                for c in 0..2 * n {
+                    for r in 0..n {
+                        a[(n + r, c)] = x[(r, c)];
+                    }
+                }
             }
             InvMass::Diagonal(inv) => {
                 for c in 0..2 * n {
@@ -1415,6 +1487,35 @@ impl Lumped {
             k: -jf.columns(0, n),
             c: -jf.columns(n, n),
         }
+    }
+
+    /// [`Lumped::second_order_dyn`] with sparse matrices (what a large FE
+    /// model needs: its files' matrices plus the contacts' few terms, never
+    /// an `n × n` dense matrix).
+    pub fn second_order_sparse(&self, z: &[f64]) -> SparseSecondOrder {
+        let n = self.dofs.len();
+        let modes = self.sliding_modes_at(z);
+        let (mut k, mut c) = (Vec::new(), Vec::new());
+        self.force_jacobian_terms(&modes, z, &mut |r, col, v| {
+            if v != 0.0 {
+                if col < n {
+                    k.push((r, col, -v));
+                } else {
+                    c.push((r, col - n, -v));
+                }
+            }
+        });
+        let mut m: Vec<(usize, usize, f64)> = self
+            .m_matrix
+            .as_ref()
+            .map_or_else(Vec::new, |m| m.entries().collect());
+        m.extend(
+            (0..n)
+                .filter(|&i| self.masses[i] != 0.0)
+                .map(|i| (i, i, self.masses[i])),
+        );
+        SparseSecondOrder::from_triplets(n, &m, &k, &c)
+            .expect("the model's indices are within its dofs")
     }
 }
 

@@ -50,7 +50,19 @@ pub fn composition(
     let mq: Vec<Complex<f64>> = (0..n)
         .map(|i| (0..n).fold(Complex::new(0.0, 0.0), |s, j| s + q[j] * m[(i, j)]))
         .collect();
-    let norm_q: f64 = q.iter().zip(&mq).map(|(a, b)| (a.conj() * b).re).sum();
+    composition_of(&mq, basis, q, min_share, max)
+}
+
+/// [`composition`] with `M q` given (`mq`, length `n`): for a sparse `M`.
+pub fn composition_of(
+    mq: &[Complex<f64>],
+    basis: &UndampedBasis,
+    q: &[Complex<f64>],
+    min_share: f64,
+    max: usize,
+) -> Composition {
+    let n = q.len();
+    let norm_q: f64 = q.iter().zip(mq).map(|(a, b)| (a.conj() * b).re).sum();
     let cols = basis.phi.ncols();
     let y: Vec<Complex<f64>> = (0..cols)
         .map(|c| (0..n).fold(Complex::new(0.0, 0.0), |s, i| s + mq[i] * basis.phi[(i, c)]))

@@ -14,6 +14,13 @@ use super::{Analysis, StabilityError};
 use crate::model::lumped::Lumped;
 use nalgebra::DMatrix;
 
+/// Whether a model analysed by projection stays sparse: more than
+/// [`crate::linear::SPARSE_FROM_DOFS`] dofs (its real modes by
+/// [`super::lanczos`]).
+pub fn sparse(l: &Lumped) -> bool {
+    l.dof_count() > crate::linear::SPARSE_FROM_DOFS
+}
+
 /// The steady-sliding state and the state matrix there, both checked finite.
 pub fn state_matrix(l: &Lumped) -> Result<(Vec<f64>, DMatrix<f64>), StabilityError> {
     let z = equilibrium(l)?;
@@ -45,7 +52,15 @@ pub fn eigenvalues_with_method(
 ) -> Result<(Vec<nalgebra::Complex<f64>>, Method), StabilityError> {
     if l.modal.projects(l.dof_count()) {
         let z = equilibrium(l)?;
-        projected::projected_eigenvalues(&l.second_order_dyn(&z), l.modal.basis(), l.modal.kind)
+        if sparse(l) {
+            projected::projected_eigenvalues(
+                &l.second_order_sparse(&z),
+                l.modal.basis(),
+                l.modal.kind,
+            )
+        } else {
+            projected::projected_eigenvalues(&l.second_order_dyn(&z), l.modal.basis(), l.modal.kind)
+        }
     } else {
         let (_, a) = state_matrix(l)?;
         Ok((super::modal::eigenvalues(&a)?, Method::Dense))
@@ -75,7 +90,11 @@ pub fn max_growth_rate(l: &Lumped) -> Result<(f64, f64), StabilityError> {
 pub fn truncation_table(l: &Lumped) -> Option<Result<Vec<projected::Truncation>, StabilityError>> {
     l.modal.projects(l.dof_count()).then(|| {
         let z = equilibrium(l)?;
-        projected::truncation_table(&l.second_order_dyn(&z), l.modal.basis(), l.modal.kind)
+        if sparse(l) {
+            projected::truncation_table(&l.second_order_sparse(&z), l.modal.basis(), l.modal.kind)
+        } else {
+            projected::truncation_table(&l.second_order_dyn(&z), l.modal.basis(), l.modal.kind)
+        }
     })
 }
 
@@ -87,14 +106,14 @@ pub fn truncation_table(l: &Lumped) -> Option<Result<Vec<projected::Truncation>,
 pub fn analyse(l: &Lumped, masses: Option<&[f64]>) -> Result<Analysis, StabilityError> {
     if l.modal.projects(l.dof_count()) {
         let z = equilibrium(l)?;
-        projected::analyse_projected(
-            &l.second_order_dyn(&z),
-            &z,
-            l.state_names(),
-            masses,
-            l.modal.basis(),
-            l.modal.kind,
-        )
+        let (basis, kind) = (l.modal.basis(), l.modal.kind);
+        if sparse(l) {
+            let sys = l.second_order_sparse(&z);
+            projected::analyse_projected(&sys, &z, l.state_names(), masses, basis, kind)
+        } else {
+            let sys = l.second_order_dyn(&z);
+            projected::analyse_projected(&sys, &z, l.state_names(), masses, basis, kind)
+        }
     } else {
         let (z, a) = state_matrix(l)?;
         super::modal::analyse_matrix(&a, &z, l.state_names(), masses)

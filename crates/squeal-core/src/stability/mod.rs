@@ -43,6 +43,7 @@
 pub mod coupling;
 pub mod craig_bampton;
 pub mod eigen;
+pub mod lanczos;
 pub mod lumped;
 pub mod modal;
 pub mod projected;

@@ -39,8 +39,207 @@ use nalgebra::{Complex, DMatrix};
 use serde::Serialize;
 
 pub use crate::linear::{
-    Basis, BasisKind, ModalOptions, SecondOrder, BAND_HZ, CUTOFF_FACTOR, DEFAULT_DENSE_MAX_DOFS,
+    Basis, BasisKind, ModalOptions, SecondOrder, SparseSecondOrder, BAND_HZ, CUTOFF_FACTOR,
+    DEFAULT_DENSE_MAX_DOFS, SPARSE_FROM_DOFS,
 };
+use faer::{Mat, MatRef};
+
+/// Which matrix of a [`Structure`] a product is with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Part {
+    /// The mass matrix.
+    M,
+    /// The stiffness, non-symmetric where friction acts.
+    K,
+    /// The damping.
+    C,
+    /// The symmetric part of the stiffness, `K_s = (K + Kᵀ)/2`.
+    Ks,
+}
+
+/// What the projection needs of a linearised system: products with its
+/// matrices, a shifted static solve, the dofs where it is non-symmetric and
+/// its real modes. [`SecondOrder`] does it densely (every real mode by a
+/// dense symmetric eigen-solve), [`SparseSecondOrder`] sparsely (a sparse
+/// factorisation and [`super::lanczos`]), so one projection serves both.
+pub trait Structure {
+    /// Number of dofs.
+    fn dofs(&self) -> usize;
+    /// `X V` for the matrix `part` (`n × cols`).
+    fn mul(&self, part: Part, v: MatRef<'_, f64>) -> Mat<f64>;
+    /// `(K_s + s M)⁻¹ B`.
+    fn shifted_solve(&self, s: f64, b: MatRef<'_, f64>) -> Result<Mat<f64>, StabilityError>;
+    /// The dofs where `K ≠ Kᵀ` or `C ≠ Cᵀ` beyond round-off: the friction
+    /// contacts' dofs ([`coupling_dofs`]).
+    fn coupling_dofs(&self) -> Vec<usize>;
+    /// The undamped modes `K_s φ = ω² M φ` that `basis` asks for,
+    /// `M`-orthonormal, ascending.
+    fn undamped(&self, basis: Basis) -> Result<UndampedBasis, StabilityError>;
+    /// Sizes consistent and every entry finite; the number of dofs.
+    fn validate(&self) -> Result<usize, StabilityError>;
+    /// The system with dense matrices (Craig–Bampton works densely).
+    fn dense(&self) -> std::borrow::Cow<'_, SecondOrder>;
+}
+
+impl Structure for SecondOrder {
+    fn dofs(&self) -> usize {
+        self.m.nrows()
+    }
+    fn mul(&self, part: Part, v: MatRef<'_, f64>) -> Mat<f64> {
+        use faer::linalg::matmul::matmul;
+        use faer::{Accum, Par};
+        let n = self.m.nrows();
+        fn view(a: &DMatrix<f64>, n: usize) -> faer::MatRef<'_, f64> {
+            faer::MatRef::from_column_major_slice(a.as_slice(), n, n)
+        }
+        let mut out = Mat::<f64>::zeros(n, v.ncols());
+        match part {
+            Part::Ks => {
+                let k = view(&self.k, n);
+                matmul(out.as_mut(), Accum::Replace, k, v, 0.5, Par::Seq);
+                matmul(out.as_mut(), Accum::Add, k.transpose(), v, 0.5, Par::Seq);
+            }
+            _ => {
+                let a = match part {
+                    Part::M => &self.m,
+                    Part::K => &self.k,
+                    _ => &self.c,
+                };
+                matmul(out.as_mut(), Accum::Replace, view(a, n), v, 1.0, Par::Seq);
+            }
+        }
+        out
+    }
+    fn shifted_solve(&self, s: f64, b: MatRef<'_, f64>) -> Result<Mat<f64>, StabilityError> {
+        use faer::linalg::solvers::Solve;
+        let n = self.m.nrows();
+        let lu = Mat::<f64>::from_fn(n, n, |i, j| {
+            0.5 * (self.k[(i, j)] + self.k[(j, i)]) + s * self.m[(i, j)]
+        })
+        .partial_piv_lu();
+        Ok(lu.solve(b))
+    }
+    fn coupling_dofs(&self) -> Vec<usize> {
+        coupling_dofs(self)
+    }
+    fn undamped(&self, basis: Basis) -> Result<UndampedBasis, StabilityError> {
+        undamped_basis(self, basis)
+    }
+    fn validate(&self) -> Result<usize, StabilityError> {
+        check(self)
+    }
+    fn dense(&self) -> std::borrow::Cow<'_, SecondOrder> {
+        std::borrow::Cow::Borrowed(self)
+    }
+}
+
+impl SparseSecondOrder {
+    /// `K_s = (K + Kᵀ)/2`, sparse.
+    pub fn symmetric_stiffness(&self) -> faer::sparse::SparseColMat<usize, f64> {
+        let n = self.dofs();
+        let k = self.k.as_ref();
+        let mut t = Vec::with_capacity(2 * k.compute_nnz());
+        for j in 0..n {
+            for (i, &v) in k.row_idx_of_col(j).zip(k.val_of_col(j)) {
+                t.push(faer::sparse::Triplet::new(i, j, 0.5 * v));
+                t.push(faer::sparse::Triplet::new(j, i, 0.5 * v));
+            }
+        }
+        faer::sparse::SparseColMat::try_new_from_triplets(n, n, &t)
+            .expect("the indices of K are in range")
+    }
+}
+
+impl Structure for SparseSecondOrder {
+    fn dofs(&self) -> usize {
+        SparseSecondOrder::dofs(self)
+    }
+    fn mul(&self, part: Part, v: MatRef<'_, f64>) -> Mat<f64> {
+        use super::lanczos::sparse_mul;
+        match part {
+            Part::M => sparse_mul(self.m.as_ref(), v),
+            Part::K => sparse_mul(self.k.as_ref(), v),
+            Part::C => sparse_mul(self.c.as_ref(), v),
+            Part::Ks => {
+                let mut out = sparse_mul(self.k.as_ref(), v);
+                faer::sparse::linalg::matmul::sparse_dense_matmul(
+                    out.as_mut(),
+                    faer::Accum::Add,
+                    self.k.as_ref().transpose(),
+                    v,
+                    1.0,
+                    faer::Par::Seq,
+                );
+                out * faer::Scale(0.5)
+            }
+        }
+    }
+    fn shifted_solve(&self, s: f64, b: MatRef<'_, f64>) -> Result<Mat<f64>, StabilityError> {
+        super::lanczos::shifted_solve(self.symmetric_stiffness().as_ref(), self.m.as_ref(), s, b)
+    }
+    fn coupling_dofs(&self) -> Vec<usize> {
+        let n = self.dofs();
+        let mut on = vec![false; n];
+        for a in [&self.k, &self.c] {
+            let scale = a.val().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let tol = 1e-12 * scale;
+            let at = a.as_ref().transpose().to_col_major().expect("allocation");
+            // Entries of A − Aᵀ: merge each column of A with the same column of Aᵀ.
+            for j in 0..n {
+                let mut x: Vec<(usize, f64)> = a
+                    .row_idx_of_col(j)
+                    .zip(a.val_of_col(j))
+                    .map(|(i, v)| (i, *v))
+                    .collect();
+                x.extend(
+                    at.row_idx_of_col(j)
+                        .zip(at.val_of_col(j))
+                        .map(|(i, v)| (i, -*v)),
+                );
+                x.sort_by_key(|e| e.0);
+                let mut k = 0;
+                while k < x.len() {
+                    let (i, mut d) = x[k];
+                    k += 1;
+                    while k < x.len() && x[k].0 == i {
+                        d += x[k].1;
+                        k += 1;
+                    }
+                    if i != j && d.abs() > tol {
+                        on[i] = true;
+                        on[j] = true;
+                    }
+                }
+            }
+        }
+        (0..n).filter(|&i| on[i]).collect()
+    }
+    fn undamped(&self, basis: Basis) -> Result<UndampedBasis, StabilityError> {
+        super::lanczos::lowest_modes(self.symmetric_stiffness().as_ref(), self.m.as_ref(), basis)
+    }
+    fn validate(&self) -> Result<usize, StabilityError> {
+        let n = self.dofs();
+        for (name, a) in [("M", &self.m), ("K", &self.k), ("C", &self.c)] {
+            if a.nrows() != n || a.ncols() != n {
+                return Err(StabilityError::BadInput(format!(
+                    "{name} is {} × {}, expected {n} × {n}",
+                    a.nrows(),
+                    a.ncols()
+                )));
+            }
+            if a.val().iter().any(|x| !x.is_finite()) {
+                return Err(StabilityError::NonFinite { what: "Jacobian" });
+            }
+        }
+        if n == 0 {
+            return Err(StabilityError::BadInput("the model has no dofs".into()));
+        }
+        Ok(n)
+    }
+    fn dense(&self) -> std::borrow::Cow<'_, SecondOrder> {
+        std::borrow::Cow::Owned(self.to_dense())
+    }
+}
 
 /// How an [`Analysis`] was computed (reported with it).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
@@ -115,118 +314,122 @@ pub fn coupling_dofs(sys: &SecondOrder) -> Vec<usize> {
 /// `K_s` (Rayleigh–Ritz). The reduced model then represents static loads at
 /// those dofs exactly up to the shift: a truncated basis of modes alone
 /// cannot (a contact's stiffness coupling deforms the structure locally).
-pub fn with_static_correction(
-    sys: &SecondOrder,
+pub fn with_static_correction<S: Structure + ?Sized>(
+    sys: &S,
     b: UndampedBasis,
     dofs: &[usize],
 ) -> Result<UndampedBasis, StabilityError> {
-    if dofs.is_empty() || b.phi.ncols() >= sys.m.nrows() {
+    if dofs.is_empty() || b.phi.ncols() >= sys.dofs() {
         return Ok(b);
     }
-    augment(sys, b, &static_responses(sys, dofs))
+    augment(sys, b, &static_responses(sys, dofs)?)
 }
 
 /// The shifted static responses `(K_s + s M)⁻¹ e_j` to unit loads at
 /// `dofs` (`n × dofs.len()`), `s = (2π · 1 Hz)²` ([`with_static_correction`]).
-fn static_responses(sys: &SecondOrder, dofs: &[usize]) -> faer::Mat<f64> {
-    use faer::linalg::solvers::Solve;
-    use faer::Mat;
-    let n = sys.m.nrows();
+fn static_responses<S: Structure + ?Sized>(
+    sys: &S,
+    dofs: &[usize],
+) -> Result<faer::Mat<f64>, StabilityError> {
     let shift = (2.0 * std::f64::consts::PI).powi(2);
-    let lu = Mat::<f64>::from_fn(n, n, |i, j| {
-        0.5 * (sys.k[(i, j)] + sys.k[(j, i)]) + shift * sys.m[(i, j)]
-    })
-    .partial_piv_lu();
-    let mut e = Mat::<f64>::zeros(n, dofs.len());
+    let mut e = Mat::<f64>::zeros(sys.dofs(), dofs.len());
     for (c, &j) in dofs.iter().enumerate() {
         e[(j, c)] = 1.0;
     }
-    lu.solve(&e)
+    sys.shifted_solve(shift, e.as_ref())
 }
 
 /// `b` augmented by the static responses `r` (columns), `M`-orthogonalised
 /// against the modes and each other and diagonalised in `K_s`
 /// ([`with_static_correction`]).
-fn augment(
-    sys: &SecondOrder,
+fn augment<S: Structure + ?Sized>(
+    sys: &S,
     b: UndampedBasis,
     r: &faer::Mat<f64>,
 ) -> Result<UndampedBasis, StabilityError> {
-    use faer::Mat;
-    let n = sys.m.nrows();
+    use faer::linalg::matmul::matmul;
+    use faer::{Accum, Par};
+    let n = sys.dofs();
     let m = b.phi.ncols();
     if m >= n || r.ncols() == 0 {
         return Ok(b);
     }
-    let ks = Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (sys.k[(i, j)] + sys.k[(j, i)]));
-    // `M v` once per pass: `uᵀ M v = u · (M v)` for every `u` (M symmetric).
-    let m_times = |v: &[f64]| -> Vec<f64> {
-        (0..n)
-            .map(|i| (0..n).map(|j| sys.m[(i, j)] * v[j]).sum())
-            .collect()
-    };
-    let dot = |x: &[f64], y: &[f64]| -> f64 { x.iter().zip(y).map(|(a, b)| a * b).sum() };
-    let modes: Vec<Vec<f64>> = (0..m)
-        .map(|c| (0..n).map(|i| b.phi[(i, c)]).collect())
-        .collect();
-    let mut kept: Vec<Vec<f64>> = Vec::new();
+    // `M`-orthogonalise each response against the modes and the responses
+    // kept so far (twice: classical Gram–Schmidt by blocks, the modes'
+    // `M Φ` computed once).
+    let mphi = sys.mul(Part::M, b.phi.as_ref());
+    let mut kept = Mat::<f64>::zeros(n, 0);
+    let mut mkept = Mat::<f64>::zeros(n, 0);
     for c in 0..r.ncols() {
-        let mut v: Vec<f64> = (0..n).map(|i| r[(i, c)]).collect();
-        if v.iter().any(|x| !x.is_finite()) {
+        let mut v = r.as_ref().subcols(c, 1).to_owned();
+        if v.col(0).iter().any(|x| !x.is_finite()) {
             continue;
         }
-        let norm0 = dot(&v, &m_times(&v)).sqrt();
+        let norm0 = m_norm(sys, &v);
         for _ in 0..2 {
-            let mv = m_times(&v);
-            let coefs: Vec<f64> = modes
-                .iter()
-                .chain(kept.iter())
-                .map(|u| dot(u, &mv))
-                .collect();
-            for (u, p) in modes.iter().chain(kept.iter()).zip(coefs) {
-                for (vi, ui) in v.iter_mut().zip(u) {
-                    *vi -= p * ui;
+            for (basis, mbasis) in [(&b.phi, &mphi), (&kept, &mkept)] {
+                if basis.ncols() == 0 {
+                    continue;
                 }
+                let coef = mbasis.transpose() * &v;
+                matmul(
+                    v.as_mut(),
+                    Accum::Add,
+                    basis.as_ref(),
+                    coef.as_ref(),
+                    -1.0,
+                    Par::Seq,
+                );
             }
         }
-        let norm = dot(&v, &m_times(&v)).sqrt();
+        let norm = m_norm(sys, &v);
         if norm > 1e-8 * norm0 && norm.is_finite() {
-            v.iter_mut().for_each(|x| *x /= norm);
-            kept.push(v);
+            v *= faer::Scale(1.0 / norm);
+            let mv = sys.mul(Part::M, v.as_ref());
+            kept = concat(&kept, &v);
+            mkept = concat(&mkept, &mv);
         }
     }
-    let r = kept.len();
+    let r = kept.ncols();
     if r == 0 {
         return Ok(b);
     }
     // Rayleigh–Ritz in the static block: Rᵀ K_s R = W Λ Wᵀ (the block is
     // K_s-orthogonal to the modes, which are eigenvectors).
-    let rm = Mat::<f64>::from_fn(n, r, |i, c| kept[c][i]);
-    let ksr = &ks * &rm;
-    let small = rm.transpose() * &ksr;
+    let ksr = sys.mul(Part::Ks, kept.as_ref());
+    let small = kept.transpose() * &ksr;
     let small = Mat::<f64>::from_fn(r, r, |i, j| 0.5 * (small[(i, j)] + small[(j, i)]));
-    let evd = small
-        .self_adjoint_eigen(faer::Side::Lower)
-        .map_err(|_| StabilityError::NoConvergence)?;
-    let w = evd.U();
-    let rot = &rm * w;
-    let mut phi = Mat::<f64>::zeros(n, m + r);
-    for c in 0..m {
-        for i in 0..n {
-            phi[(i, c)] = b.phi[(i, c)];
-        }
-    }
-    for c in 0..r {
-        for i in 0..n {
-            phi[(i, m + c)] = rot[(i, c)];
-        }
-    }
+    let (values, w) = super::lanczos::symmetric_eigen(small.as_ref())?;
+    let rot = &kept * &w;
+    let phi = concat(&b.phi, &rot);
     let mut omega2 = b.omega2;
-    omega2.extend((0..r).map(|i| evd.S()[i]));
+    omega2.extend(values);
     Ok(UndampedBasis {
         phi,
         omega2,
         static_vectors: r,
+    })
+}
+
+/// `√(vᵀ M v)` of one column.
+fn m_norm<S: Structure + ?Sized>(sys: &S, v: &Mat<f64>) -> f64 {
+    let mv = sys.mul(Part::M, v.as_ref());
+    (0..v.nrows())
+        .map(|i| v[(i, 0)] * mv[(i, 0)])
+        .sum::<f64>()
+        .max(0.0)
+        .sqrt()
+}
+
+/// `[a b]`, side by side.
+fn concat(a: &Mat<f64>, b: &Mat<f64>) -> Mat<f64> {
+    let (ca, cb) = (a.ncols(), b.ncols());
+    Mat::from_fn(a.nrows().max(b.nrows()), ca + cb, |i, j| {
+        if j < ca {
+            a[(i, j)]
+        } else {
+            b[(i, j - ca)]
+        }
     })
 }
 
@@ -259,8 +462,6 @@ fn check(sys: &SecondOrder) -> Result<usize, StabilityError> {
 /// positive definite, an empty basis (no mode below the cut-off), a
 /// non-converging eigen-solver.
 pub fn undamped_basis(sys: &SecondOrder, basis: Basis) -> Result<UndampedBasis, StabilityError> {
-    use faer::dyn_stack::{MemBuffer, MemStack};
-    use faer::linalg::evd::{self, ComputeEigenvectors};
     use faer::linalg::triangular_solve as tri;
     use faer::{Mat, Par, Side};
     let n = check(sys)?;
@@ -288,24 +489,8 @@ pub fn undamped_basis(sys: &SecondOrder, basis: Basis) -> Result<UndampedBasis, 
         a = Mat::from_fn(n, n, |i, j| 0.5 * (at[(i, j)] + at[(j, i)]));
         Ok(l)
     };
-    let mut s = faer::diag::Diag::<f64>::zeros(n);
-    let mut u = Mat::<f64>::zeros(n, n);
-    let scratch =
-        evd::self_adjoint_evd_scratch::<f64>(n, ComputeEigenvectors::Yes, par, Default::default());
-    evd::self_adjoint_evd(
-        a.as_ref(),
-        s.as_mut(),
-        Some(u.as_mut()),
-        par,
-        MemStack::new(&mut MemBuffer::new(scratch)),
-        Default::default(),
-    )
-    .map_err(|_| StabilityError::NoConvergence)?;
+    let (omega2, u) = super::lanczos::symmetric_eigen(a.as_ref())?;
     drop(a);
-    let omega2: Vec<f64> = (0..n).map(|i| s[i]).collect();
-    if omega2.iter().any(|x| !x.is_finite()) {
-        return Err(StabilityError::NoConvergence);
-    }
     let m = match basis {
         Basis::Modes(m) => m.min(n),
         Basis::CutoffHz(f) => {
@@ -341,21 +526,12 @@ pub fn undamped_basis(sys: &SecondOrder, basis: Basis) -> Result<UndampedBasis, 
     })
 }
 
-/// `Φᵀ X Φ` (`m × m`).
-fn project(phi: &faer::Mat<f64>, x: &DMatrix<f64>) -> faer::Mat<f64> {
+/// `Φᵀ X Φ` (`m × m`) for the matrix `part` of `sys`.
+fn project<S: Structure + ?Sized>(sys: &S, part: Part, phi: &Mat<f64>) -> Mat<f64> {
     use faer::linalg::matmul::matmul;
-    use faer::{Accum, Mat, Par};
-    let (n, m) = (phi.nrows(), phi.ncols());
-    let xf = faer::MatRef::from_column_major_slice(x.as_slice(), n, n);
-    let mut xphi = Mat::<f64>::zeros(n, m);
-    matmul(
-        xphi.as_mut(),
-        Accum::Replace,
-        xf,
-        phi.as_ref(),
-        1.0,
-        Par::Seq,
-    );
+    use faer::{Accum, Par};
+    let xphi = sys.mul(part, phi.as_ref());
+    let m = phi.ncols();
     let mut out = Mat::<f64>::zeros(m, m);
     matmul(
         out.as_mut(),
@@ -369,10 +545,10 @@ fn project(phi: &faer::Mat<f64>, x: &DMatrix<f64>) -> faer::Mat<f64> {
 }
 
 /// The reduced state matrix `[[0, I], [−K_r, −C_r]]` (`2m × 2m`).
-fn reduced_state_matrix(sys: &SecondOrder, b: &UndampedBasis) -> DMatrix<f64> {
+fn reduced_state_matrix<S: Structure + ?Sized>(sys: &S, b: &UndampedBasis) -> DMatrix<f64> {
     let m = b.phi.ncols();
-    let kr = project(&b.phi, &sys.k);
-    let cr = project(&b.phi, &sys.c);
+    let kr = project(sys, Part::K, &b.phi);
+    let cr = project(sys, Part::C, &b.phi);
     let mut a = DMatrix::<f64>::zeros(2 * m, 2 * m);
     for i in 0..m {
         a[(i, m + i)] = 1.0;
@@ -384,11 +560,11 @@ fn reduced_state_matrix(sys: &SecondOrder, b: &UndampedBasis) -> DMatrix<f64> {
     a
 }
 
-fn method(sys: &SecondOrder, b: &UndampedBasis, basis: BasisKind) -> Method {
+fn method<S: Structure + ?Sized>(sys: &S, b: &UndampedBasis, basis: BasisKind) -> Method {
     let modes = b.phi.ncols() - b.static_vectors;
     Method::Projected {
         modes,
-        dofs: sys.m.nrows(),
+        dofs: sys.dofs(),
         basis_max_hz: b.omega2[..modes]
             .last()
             .map_or(0.0, |w2| w2.max(0.0).sqrt())
@@ -401,21 +577,24 @@ fn method(sys: &SecondOrder, b: &UndampedBasis, basis: BasisKind) -> Method {
 /// The projection basis of a friction-coupled system: the undamped modes
 /// `basis` asks for, with the static correction at the dofs where the
 /// coupling is non-symmetric ([`coupling_dofs`], [`with_static_correction`]).
-pub fn corrected_basis(sys: &SecondOrder, basis: Basis) -> Result<UndampedBasis, StabilityError> {
-    let b = undamped_basis(sys, basis)?;
-    with_static_correction(sys, b, &coupling_dofs(sys))
+pub fn corrected_basis<S: Structure + ?Sized>(
+    sys: &S,
+    basis: Basis,
+) -> Result<UndampedBasis, StabilityError> {
+    let b = sys.undamped(basis)?;
+    with_static_correction(sys, b, &sys.coupling_dofs())
 }
 
 /// The projection basis of `kind`: [`corrected_basis`], or
-/// [`craig_bampton_basis`].
-pub fn basis_of(
-    sys: &SecondOrder,
+/// [`craig_bampton_basis`] (of the dense system).
+pub fn basis_of<S: Structure + ?Sized>(
+    sys: &S,
     basis: Basis,
     kind: BasisKind,
 ) -> Result<UndampedBasis, StabilityError> {
     match kind {
         BasisKind::Modes => corrected_basis(sys, basis),
-        BasisKind::CraigBampton => craig_bampton_basis(sys, basis),
+        BasisKind::CraigBampton => craig_bampton_basis(&sys.dense(), basis),
     }
 }
 
@@ -492,21 +671,21 @@ pub struct Truncation {
 /// once; each row costs one reduced eigen-solve. An eigenvalue that still
 /// moves between the last two rows has not settled: more modes (a higher
 /// `modal.cutoff_hz`) would move it further.
-pub fn truncation_table(
-    sys: &SecondOrder,
+pub fn truncation_table<S: Structure + ?Sized>(
+    sys: &S,
     basis: Basis,
     kind: BasisKind,
 ) -> Result<Vec<Truncation>, StabilityError> {
     if kind == BasisKind::CraigBampton {
-        return craig_bampton_truncation(sys, basis);
+        return craig_bampton_truncation(&sys.dense(), basis);
     }
-    let full = undamped_basis(sys, basis)?;
+    let full = sys.undamped(basis)?;
     let m = full.phi.ncols();
-    let dofs = coupling_dofs(sys);
-    let responses = if dofs.is_empty() || m >= sys.m.nrows() {
-        faer::Mat::<f64>::zeros(sys.m.nrows(), 0)
+    let dofs = sys.coupling_dofs();
+    let responses = if dofs.is_empty() || m >= sys.dofs() {
+        faer::Mat::<f64>::zeros(sys.dofs(), 0)
     } else {
-        static_responses(sys, &dofs)
+        static_responses(sys, &dofs)?
     };
     let mut counts: Vec<usize> = [1usize, 2, 3, 4]
         .iter()
@@ -573,8 +752,8 @@ fn craig_bampton_truncation(
 
 /// The eigenvalues of the projected problem (see the module docs), without
 /// eigenvectors, and the [`Method`] used.
-pub fn projected_eigenvalues(
-    sys: &SecondOrder,
+pub fn projected_eigenvalues<S: Structure + ?Sized>(
+    sys: &S,
     basis: Basis,
     kind: BasisKind,
 ) -> Result<(Vec<Complex<f64>>, Method), StabilityError> {
@@ -583,26 +762,35 @@ pub fn projected_eigenvalues(
     Ok((eigenvalues(&a)?, method(sys, &b, kind)))
 }
 
+/// Most eigenvector entries an analysis by projection keeps (complex
+/// numbers, 16 bytes each: 256 MB). A 10⁵-dof brake has hundreds of modes
+/// of `2n` entries each; beyond this budget only the growing modes and the
+/// least stable others (in the order of [`Analysis::eigen`]) keep their
+/// eigenvectors and energy shares, the rest keep their eigenvalue and
+/// dominant dof with an empty [`super::Eigen::vector`] and
+/// [`super::Eigen::participation`].
+pub const VECTOR_BUDGET: usize = 16_000_000;
+
 /// Complex eigenvalue analysis by projection (see the module docs): the
 /// same [`Analysis`] as [`super::modal::analyse_matrix`] (modes by growth
 /// rate, eigenvectors as states `(q, λ q)` in the physical dofs, unit 2-norm,
 /// largest component real positive; energy shares with `masses`), for the
 /// `2m` eigenvalues of the reduced problem, with
-/// [`Analysis::method`] = [`Method::Projected`].
+/// [`Analysis::method`] = [`Method::Projected`]; within the
+/// [`VECTOR_BUDGET`] (every eigenvector of models up to a few thousand
+/// dofs).
 ///
 /// - `z`: the equilibrium (`2n` values), `state_names`: `2n` names (dofs,
 ///   then velocities), `masses`: `n` positive masses or `None`.
-pub fn analyse_projected(
-    sys: &SecondOrder,
+pub fn analyse_projected<S: Structure + ?Sized>(
+    sys: &S,
     z: &[f64],
     state_names: &[String],
     masses: Option<&[f64]>,
     basis: Basis,
     kind: BasisKind,
 ) -> Result<Analysis, StabilityError> {
-    use faer::linalg::matmul::matmul;
-    use faer::{Accum, Mat, Par};
-    let n = check(sys)?;
+    let n = sys.validate()?;
     if z.len() != 2 * n || state_names.len() != 2 * n {
         return Err(StabilityError::BadInput(format!(
             "{n} dofs but the equilibrium has {} values and there are {} state names",
@@ -619,35 +807,22 @@ pub fn analyse_projected(
     }
     let b = basis_of(sys, basis, kind)?;
     let a = reduced_state_matrix(sys, &b);
-    let pairs = eigenpairs(&a)?;
+    let mut pairs = eigenpairs(&a)?;
+    // In the order of the analysis (growth rate descending, +ω first), so
+    // that the budget keeps the vectors that matter.
+    pairs.sort_by(|p, q| q.0.re.total_cmp(&p.0.re).then(q.0.im.total_cmp(&p.0.im)));
     let m = b.phi.ncols();
-    // Position parts of every reduced eigenvector (m × 2m, Re and Im), mapped
-    // back at once: Q = Φ Y.
-    let k = pairs.len();
-    let y_re = Mat::<f64>::from_fn(m, k, |i, j| pairs[j].1[i].re);
-    let y_im = Mat::<f64>::from_fn(m, k, |i, j| pairs[j].1[i].im);
-    let mut q_re = Mat::<f64>::zeros(n, k);
-    let mut q_im = Mat::<f64>::zeros(n, k);
-    matmul(
-        q_re.as_mut(),
-        Accum::Replace,
-        b.phi.as_ref(),
-        y_re.as_ref(),
-        1.0,
-        Par::Seq,
-    );
-    matmul(
-        q_im.as_mut(),
-        Accum::Replace,
-        b.phi.as_ref(),
-        y_im.as_ref(),
-        1.0,
-        Par::Seq,
-    );
-    let modes = pairs
-        .iter()
-        .enumerate()
-        .map(|(j, (lambda, _))| {
+    let keep = (VECTOR_BUDGET / (2 * n)).max(1);
+    // Q = Φ Y by blocks of modes (one matrix product per block, no
+    // n × 2m matrix held).
+    const CHUNK: usize = 64;
+    let mut modes = Vec::with_capacity(pairs.len());
+    for (start, chunk) in pairs.chunks(CHUNK).enumerate() {
+        let k = chunk.len();
+        let y_re = Mat::<f64>::from_fn(m, k, |i, j| chunk[j].1[i].re);
+        let y_im = Mat::<f64>::from_fn(m, k, |i, j| chunk[j].1[i].im);
+        let (q_re, q_im) = (&b.phi * &y_re, &b.phi * &y_im);
+        for (j, (lambda, _)) in chunk.iter().enumerate() {
             let mut u: Vec<Complex<f64>> = (0..n)
                 .map(|i| Complex::new(q_re[(i, j)], q_im[(i, j)]))
                 .collect();
@@ -656,9 +831,14 @@ pub fn analyse_projected(
                 u.push(v);
             }
             super::eigen::normalise(&mut u);
-            describe(*lambda, u, masses, state_names)
-        })
-        .collect();
+            let mut e = describe(*lambda, u, masses, state_names);
+            if start * CHUNK + j >= keep && !e.growing {
+                e.vector = Vec::new();
+                e.participation = Vec::new();
+            }
+            modes.push(e);
+        }
+    }
     let mut an = finish(modes, z.to_vec());
     an.method = method(sys, &b, kind);
     Ok(an)

@@ -51,7 +51,7 @@ impl Lumped {
                 inv_mass[..n].copy_from_slice(inv);
                 true
             }
-            InvMass::Dense(_) => false,
+            InvMass::Dense(_) | InvMass::Factored(_) => false,
         };
         let plain = diagonal && off.is_empty() && !self.has_ramp;
         let contacts = self
