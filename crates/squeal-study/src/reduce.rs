@@ -21,7 +21,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 use squeal_core::linear::Basis;
 use squeal_core::model::lumped::Triplets;
-use squeal_core::stability::craig_bampton::{craig_bampton, CraigBampton};
+use squeal_core::stability::craig_bampton::{craig_bampton, craig_bampton_sparse, CraigBampton};
 
 /// The files `squeal reduce --out DIR` writes.
 pub const FILES: [&str; 5] = ["scenario.toml", "M.mtx", "K.mtx", "C.mtx", "reduce.json"];
@@ -108,17 +108,6 @@ fn triplets(a: &DMatrix<f64>) -> Triplets {
     }
 }
 
-/// `Tᵀ A T`, exactly symmetric when `A` is (the product's round-off would
-/// otherwise make a symmetric mass matrix unreadable as one).
-fn reduced(cb: &CraigBampton, a: &DMatrix<f64>) -> DMatrix<f64> {
-    let r = cb.project(a);
-    if a == &a.transpose() {
-        (&r + r.transpose()) * 0.5
-    } else {
-        r
-    }
-}
-
 /// Every key and string anywhere in `v` that names a dof.
 fn named_dofs(v: &toml::Value, is_dof: &dyn Fn(&str) -> bool, out: &mut Vec<String>) {
     match v {
@@ -194,9 +183,29 @@ pub fn reduce(sc: &Scenario) -> Result<Reduction, StudyError> {
     } else {
         Basis::CutoffHz(l.modal.cutoff_hz)
     };
-    let (md, kd) = (m.to_dense(), k.to_dense());
-    let cb: CraigBampton = craig_bampton(&md, &kd, &boundary, basis)
-        .map_err(|e| InputError(format!("reduce: {e}")))?;
+    // Dense up to SPARSE_FROM_DOFS dofs (every interior mode, so the
+    // truncation is visible); sparse above (only the modes kept).
+    let sparse = n > squeal_core::linear::SPARSE_FROM_DOFS;
+    let cb: CraigBampton = if sparse {
+        craig_bampton_sparse(m.to_faer().as_ref(), k.to_faer().as_ref(), &boundary, basis)
+    } else {
+        craig_bampton(&m.to_dense(), &k.to_dense(), &boundary, basis)
+    }
+    .map_err(|e| InputError(format!("reduce: {e}")))?;
+    let reduced = |a: &squeal_core::model::lumped::Sparse| {
+        let r = if sparse {
+            cb.project_sparse(a.to_faer().as_ref())
+        } else {
+            cb.project(&a.to_dense())
+        };
+        // Exactly symmetric when A is (the product's round-off would
+        // otherwise make a symmetric mass matrix unreadable as one).
+        if a.is_symmetric() {
+            (&r + r.transpose()) * 0.5
+        } else {
+            r
+        }
+    };
     let nm = cb.omega2.len();
     // Modal coordinates named cb1, cb2, …, never a name the model has.
     let mut prefix = "cb".to_string();
@@ -272,9 +281,9 @@ pub fn reduce(sc: &Scenario) -> Result<Reduction, StudyError> {
         modes_hz,
         basis: basis_json,
         shifted: cb.shifted,
-        m: triplets(&reduced(&cb, &md)),
-        k: triplets(&reduced(&cb, &kd)),
-        c: c.map(|c| triplets(&reduced(&cb, &c.to_dense()))),
+        m: triplets(&reduced(m)),
+        k: triplets(&reduced(k)),
+        c: c.map(|c| triplets(&reduced(c))),
         toml,
     })
 }

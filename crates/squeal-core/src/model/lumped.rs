@@ -136,6 +136,20 @@ impl Sparse {
             (self.row_ptr[r]..self.row_ptr[r + 1]).map(move |k| (r, self.col[k], self.val[k]))
         })
     }
+    /// The same matrix in faer's compressed columns (for sparse
+    /// factorisations and products).
+    pub fn to_faer(&self) -> faer::sparse::SparseColMat<usize, f64> {
+        let t: Vec<faer::sparse::Triplet<usize, usize, f64>> = self
+            .entries()
+            .map(|(r, c, v)| faer::sparse::Triplet::new(r, c, v))
+            .collect();
+        faer::sparse::SparseColMat::try_new_from_triplets(self.n, self.n, &t)
+            .expect("a Sparse's indices are within its size")
+    }
+    /// Whether `A = Aᵀ` exactly.
+    pub fn is_symmetric(&self) -> bool {
+        self.entries().all(|(r, c, v)| self.get(c, r) == v)
+    }
     /// The same matrix, dense.
     pub fn to_dense(&self) -> DMatrix<f64> {
         let mut d = DMatrix::<f64>::zeros(self.n, self.n);

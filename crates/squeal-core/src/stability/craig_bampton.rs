@@ -166,3 +166,151 @@ pub fn craig_bampton(
         shifted,
     })
 }
+
+/// [`craig_bampton`] of sparse `M` and `K` (symmetric parts taken), for
+/// models too large for dense matrices: `K_ii` by a sparse factorisation
+/// (with the same 1 Hz shift when the interior is free), and only the
+/// fixed-interface modes `basis` asks for, by block shift-invert Lanczos
+/// ([`super::lanczos::lowest_modes`]). `omega2` lists those kept (not every
+/// interior mode), `t` is dense `n × (boundary + kept)`.
+pub fn craig_bampton_sparse(
+    m: faer::sparse::SparseColMatRef<'_, usize, f64>,
+    k: faer::sparse::SparseColMatRef<'_, usize, f64>,
+    boundary: &[usize],
+    basis: Basis,
+) -> Result<CraigBampton, StabilityError> {
+    use faer::sparse::{SparseColMat, Triplet};
+    let n = m.nrows();
+    if m.ncols() != n || k.nrows() != n || k.ncols() != n {
+        return Err(StabilityError::BadInput(
+            "M and K must be square and of the same size".into(),
+        ));
+    }
+    let mut slot = vec![usize::MAX; n];
+    let mut is_b = vec![false; n];
+    for (c, &j) in boundary.iter().enumerate() {
+        if j >= n || is_b[j] {
+            return Err(StabilityError::BadInput(format!(
+                "boundary dof {j} out of range or repeated ({n} dofs)"
+            )));
+        }
+        is_b[j] = true;
+        slot[j] = c;
+    }
+    let interior: Vec<usize> = (0..n).filter(|&i| !is_b[i]).collect();
+    for (r, &i) in interior.iter().enumerate() {
+        slot[i] = r;
+    }
+    let (nb, ni) = (boundary.len(), interior.len());
+    // The interior blocks of M and K_s = (K + Kᵀ)/2, and K_ib (dense, ni × nb).
+    let (mut mt, mut kt) = (Vec::new(), Vec::new());
+    let mut kib = faer::Mat::<f64>::zeros(ni, nb);
+    for j in 0..n {
+        for (i, &v) in m.row_idx_of_col(j).zip(m.val_of_col(j)) {
+            if !v.is_finite() {
+                return Err(StabilityError::NonFinite { what: "M or K" });
+            }
+            if !is_b[i] && !is_b[j] {
+                mt.push(Triplet::new(slot[i], slot[j], v));
+            }
+        }
+        for (i, &v) in k.row_idx_of_col(j).zip(k.val_of_col(j)) {
+            if !v.is_finite() {
+                return Err(StabilityError::NonFinite { what: "M or K" });
+            }
+            for (r, c) in [(i, j), (j, i)] {
+                match (is_b[r], is_b[c]) {
+                    (false, false) => kt.push(Triplet::new(slot[r], slot[c], 0.5 * v)),
+                    (false, true) => kib[(slot[r], slot[c])] += 0.5 * v,
+                    _ => {}
+                }
+            }
+        }
+    }
+    let bad = |_| StabilityError::BadInput("Craig–Bampton: cannot assemble the interior".into());
+    let mii = SparseColMat::<usize, f64>::try_new_from_triplets(ni, ni, &mt).map_err(bad)?;
+    let kii = SparseColMat::<usize, f64>::try_new_from_triplets(ni, ni, &kt).map_err(bad)?;
+    let rhs = -&kib;
+    let scale = kib
+        .col_iter()
+        .flat_map(|c| c.iter().copied())
+        .fold(0.0f64, |a, v| a.max(v.abs()))
+        .max(f64::MIN_POSITIVE);
+    // Ψ = −K_ii⁻¹ K_ib, checked by its residual; shifted if K_ii is singular.
+    let attempt = |s: f64| -> Option<faer::Mat<f64>> {
+        let x = super::lanczos::shifted_solve(kii.as_ref(), mii.as_ref(), s, rhs.as_ref()).ok()?;
+        let mut res = super::lanczos::sparse_mul(kii.as_ref(), x.as_ref());
+        res += &kib;
+        let r = res
+            .col_iter()
+            .flat_map(|c| c.iter().copied())
+            .fold(0.0f64, |a, v| a.max(v.abs()));
+        (x.col_iter().all(|c| c.iter().all(|v| v.is_finite())) && r <= 1e-8 * scale).then_some(x)
+    };
+    let (psi, shifted) = if ni == 0 || nb == 0 {
+        (faer::Mat::<f64>::zeros(ni, nb), false)
+    } else if let Some(x) = attempt(0.0) {
+        (x, false)
+    } else {
+        let x = super::lanczos::shifted_solve(
+            kii.as_ref(),
+            mii.as_ref(),
+            std::f64::consts::TAU.powi(2),
+            rhs.as_ref(),
+        )
+        .map_err(|_| {
+            StabilityError::BadInput(
+                "Craig–Bampton: the interior's stiffness K_ii is singular even with a 1 Hz shift"
+                    .into(),
+            )
+        })?;
+        (x, true)
+    };
+    let modes = if ni == 0 {
+        None
+    } else {
+        Some(
+            super::lanczos::lowest_modes(kii.as_ref(), mii.as_ref(), basis).map_err(
+                |e| match e {
+                    StabilityError::BadInput(msg) => {
+                        StabilityError::BadInput(format!("Craig–Bampton, the interior: {msg}"))
+                    }
+                    other => other,
+                },
+            )?,
+        )
+    };
+    let kept = modes.as_ref().map_or(0, |b| b.omega2.len());
+    let mut t = DMatrix::<f64>::zeros(n, nb + kept);
+    for (c, &j) in boundary.iter().enumerate() {
+        t[(j, c)] = 1.0;
+        for (r, &i) in interior.iter().enumerate() {
+            t[(i, c)] = psi[(r, c)];
+        }
+    }
+    if let Some(b) = &modes {
+        for c in 0..kept {
+            for (r, &i) in interior.iter().enumerate() {
+                t[(i, nb + c)] = b.phi[(r, c)];
+            }
+        }
+    }
+    Ok(CraigBampton {
+        t,
+        boundary: boundary.to_vec(),
+        omega2: modes.map_or_else(Vec::new, |b| b.omega2),
+        interior_modes: ni,
+        shifted,
+    })
+}
+
+impl CraigBampton {
+    /// `Tᵀ A T` for a sparse `A`.
+    pub fn project_sparse(&self, a: faer::sparse::SparseColMatRef<'_, usize, f64>) -> DMatrix<f64> {
+        let (n, r) = (self.t.nrows(), self.t.ncols());
+        let t = faer::MatRef::from_column_major_slice(self.t.as_slice(), n, r);
+        let at = super::lanczos::sparse_mul(a, t);
+        let out = t.transpose() * &at;
+        DMatrix::from_fn(r, r, |i, j| out[(i, j)])
+    }
+}
