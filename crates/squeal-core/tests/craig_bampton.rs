@@ -217,8 +217,13 @@ fn the_sparse_reduction_equals_the_dense_one() {
     let boundary = [17, 150, 299];
     let basis = Basis::CutoffHz(60.0);
     let d = craig_bampton(&m, &k, &boundary, basis).unwrap();
-    let s = craig_bampton_sparse(to_sparse(&m).as_ref(), to_sparse(&k).as_ref(), &boundary, basis)
-        .unwrap();
+    let s = craig_bampton_sparse(
+        to_sparse(&m).as_ref(),
+        to_sparse(&k).as_ref(),
+        &boundary,
+        basis,
+    )
+    .unwrap();
     assert!(s.omega2.len() > 10, "{} modes", s.omega2.len());
     assert_eq!(s.t.ncols(), d.t.ncols());
     for (a, b) in d.omega2.iter().zip(&s.omega2) {

@@ -18,8 +18,9 @@ use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-/// Most bytes of a scenario file (1 MiB; a scenario is a few kB).
-pub const MAX_SCENARIO_BYTES: u64 = 1 << 20;
+/// Most bytes of a scenario file (64 MiB: a scenario is a few kB, but an
+/// FE brake's lists every dof by name, ~15 MB for 10⁶ dofs).
+pub const MAX_SCENARIO_BYTES: u64 = 64 << 20;
 
 /// Most bytes of one matrix file (4 GiB: an FE export of 10⁶ dofs with
 /// 10⁸ entries is a few GB of text).

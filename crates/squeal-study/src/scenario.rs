@@ -22,7 +22,7 @@ fn err<T>(msg: impl Into<String>) -> Result<T, InputError> {
     Err(InputError(msg.into()))
 }
 
-/// Largest scenario file read (1 MiB).
+/// Largest scenario file read (64 MiB).
 pub use crate::input::MAX_SCENARIO_BYTES;
 
 /// Most samples a run may write (guards memory against a typo in `sample_rate`).
@@ -234,7 +234,7 @@ impl Scenario {
         let path = Path::new(spec);
         if crate::input::names_a_non_folder(path) || spec.ends_with(".toml") {
             // A scenario is a few kB: a regular file or a pipe (`<(…)`),
-            // at most 1 MiB, a silent pipe given up after 10 s; a device
+            // at most 64 MiB, a silent pipe given up after 10 s; a device
             // or folder is refused by name.
             let text = crate::input::read_text_or_pipe(
                 path,

@@ -304,7 +304,11 @@ pub fn convergence(model: &AnyModel, an: &Analysis) -> Option<Result<Convergence
     let AnyModel::Lumped(l) = model else {
         return None;
     };
-    let rows = match squeal_core::stability::lumped::truncation_table(l)? {
+    if !l.modal.projects(l.dof_count()) {
+        return None;
+    }
+    // At the analysis's own steady sliding (not found again).
+    let rows = match squeal_core::stability::lumped::truncation_table_at(l, &an.equilibrium) {
         Ok(r) => r,
         Err(e) => return Some(Err(e)),
     };

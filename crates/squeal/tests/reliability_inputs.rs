@@ -282,7 +282,7 @@ fn a_scenario_may_come_from_a_pipe_with_a_limit_and_a_timeout() {
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(dir.join("piped/summary.json").is_file());
-    // A pipe that never ends is cut at the 1 MiB limit.
+    // A pipe that never ends is cut at the 64 MiB limit.
     let o = run_within(
         Command::new("bash").current_dir(dir).args([
             "-c",
@@ -290,7 +290,7 @@ fn a_scenario_may_come_from_a_pipe_with_a_limit_and_a_timeout() {
         ]),
         Duration::from_secs(20),
     );
-    refused(&o, &["larger than the 1 MiB limit"]);
+    refused(&o, &["larger than the 64 MiB limit"]);
     // A device is refused by name, not read.
     refused(
         &within(dir, &["simulate", "/dev/zero"], Duration::from_secs(5)),

@@ -88,14 +88,23 @@ pub fn max_growth_rate(l: &Lumped) -> Result<(f64, f64), StabilityError> {
 /// ([`projected::truncation_table`] with its `modal.*` basis); `None` for a
 /// model solved dense (nothing is truncated).
 pub fn truncation_table(l: &Lumped) -> Option<Result<Vec<projected::Truncation>, StabilityError>> {
-    l.modal.projects(l.dof_count()).then(|| {
-        let z = equilibrium(l)?;
-        if sparse(l) {
-            projected::truncation_table(&l.second_order_sparse(&z), l.modal.basis(), l.modal.kind)
-        } else {
-            projected::truncation_table(&l.second_order_dyn(&z), l.modal.basis(), l.modal.kind)
-        }
-    })
+    l.modal
+        .projects(l.dof_count())
+        .then(|| truncation_table_at(l, &equilibrium(l)?))
+}
+
+/// [`truncation_table`] at the steady-sliding state `z` already found (an
+/// analysis's [`Analysis::equilibrium`]): a large model's steady sliding is
+/// one sparse factorisation not worth repeating.
+pub fn truncation_table_at(
+    l: &Lumped,
+    z: &[f64],
+) -> Result<Vec<projected::Truncation>, StabilityError> {
+    if sparse(l) {
+        projected::truncation_table(&l.second_order_sparse(z), l.modal.basis(), l.modal.kind)
+    } else {
+        projected::truncation_table(&l.second_order_dyn(z), l.modal.basis(), l.modal.kind)
+    }
 }
 
 /// Full complex eigenvalue analysis of a lumped model of any size (every

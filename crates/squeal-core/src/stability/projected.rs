@@ -136,17 +136,16 @@ impl Structure for SecondOrder {
 impl SparseSecondOrder {
     /// `K_s = (K + Kᵀ)/2`, sparse.
     pub fn symmetric_stiffness(&self) -> faer::sparse::SparseColMat<usize, f64> {
-        let n = self.dofs();
-        let k = self.k.as_ref();
-        let mut t = Vec::with_capacity(2 * k.compute_nnz());
-        for j in 0..n {
-            for (i, &v) in k.row_idx_of_col(j).zip(k.val_of_col(j)) {
-                t.push(faer::sparse::Triplet::new(i, j, 0.5 * v));
-                t.push(faer::sparse::Triplet::new(j, i, 0.5 * v));
-            }
-        }
-        faer::sparse::SparseColMat::try_new_from_triplets(n, n, &t)
-            .expect("the indices of K are in range")
+        let kt = self
+            .k
+            .as_ref()
+            .transpose()
+            .to_col_major()
+            .expect("memory for Kᵀ");
+        faer::sparse::ops::binary_op(self.k.as_ref(), kt.as_ref(), |a, b| {
+            0.5 * (a.copied().unwrap_or(0.0) + b.copied().unwrap_or(0.0))
+        })
+        .expect("memory for K_s")
     }
 }
 
