@@ -36,12 +36,17 @@ pub fn run(a: ReduceArgs) -> Result<(), RunError> {
             // Refused by the study in one line.
         } else {
             crate::errln!(
-                "reduce: {} dofs; fixed-interface modes of the interior {} (a dense eigen-solve)",
+                "reduce: {} dofs; fixed-interface modes of the interior {} ({})",
                 l.dof_count(),
                 if l.modal.modes > 0 {
                     format!("(the {} lowest)", l.modal.modes)
                 } else {
                     format!("up to modal.cutoff_hz = {} Hz", l.modal.cutoff_hz)
+                },
+                if l.dof_count() > squeal_core::linear::SPARSE_FROM_DOFS {
+                    "sparse: block shift-invert Lanczos"
+                } else {
+                    "a dense eigen-solve"
                 }
             );
         }
