@@ -155,6 +155,72 @@ def write_hb_rsa(path, mat, names, title):
             f.write(f"{k + 1:10d} {node:10d}     {ANSYS[comp]}\n")
 
 
+def pad_toml(p, surface_normal_dof, tangent, speed):
+    """The [[force]] pressing pad `p` and its [[contact]] with the disc:
+    the normal gap between the disc surface's dof and the pad's normal dof
+    (signed by the pad's side), the given tangential combination."""
+    pid, side = p["id"], p["side"]
+    if side > 0:
+        normal = f"{{ {surface_normal_dof} = 1.0, {pid}_3 = -1.0 }}"
+    else:
+        normal = f"{{ {pid}_3 = 1.0, {surface_normal_dof} = -1.0 }}"
+    return [
+        "",
+        "[[force]]",
+        f'name = "brake_{pid}"',
+        f"on = {{ {pid}_3 = 1.0 }}",
+        f'value = "{fmt(-side * p["force_share"])}*Fb"',
+        "",
+        "[[contact]]",
+        f'name = "{p["name"]}"',
+        f"normal = {normal}",
+        f"k = {fmt(p['k_contact'])}",
+        f"c = {fmt(p['c_contact'])}",
+        'contact = "unilateral"',
+        f"tangent = {tangent}",
+        f"V = {fmt(speed)}",
+        'friction = "coulomb"',
+        f'mu_s = "{fmt(p["mu_ratio"] * 1.2)}*mu"',
+        f'mu_k = "{fmt(p["mu_ratio"])}*mu"',
+    ]
+
+
+def scenario_body(names, mu, force):
+    """The lines of a brake scenario after its name and description: the
+    run, the dofs in matrix order, the shared [params] and the [matrices]."""
+    return [
+        'model = "lumped"',
+        "duration = 0.05",
+        "sample_rate = 200000.0",
+        'initial = "equilibrium"',
+        "dofs = [" + ", ".join(f'"{d}"' for d in names) + "]",
+        "",
+        "[params]                          # shared by the pads: --param mu=0.2:1.2 moves all",
+        f"mu = {fmt(mu)}",
+        f"Fb = {fmt(force)}",
+        "",
+        "[matrices]",
+        'M = "M.mtx"',
+        'K = "K.mtx"',
+        'C = "C.mtx"',
+    ]
+
+
+def add_brake_args(ap, hub_k):
+    """The options every brake generator shares: the pads' caliper, the
+    damping, the friction, the brake force and the sliding speed."""
+    ap.add_argument("--hub-k", type=float, default=hub_k)
+    ap.add_argument("--caliper-k", type=float, default=4.0e7)
+    ap.add_argument("--piston-k", type=float, default=5.0e7)
+    ap.add_argument("--incline", type=float, default=1.0, help="abutment angle (rad)")
+    ap.add_argument("--damping-a", type=float, default=2.0)
+    ap.add_argument("--damping-b", type=float, default=1.0e-8)
+    ap.add_argument("--mu", type=float, default=0.45)
+    ap.add_argument("--force", type=float, default=2000.0)
+    ap.add_argument("--speed", type=float, default=5.0)
+    ap.add_argument("--out", default=".")
+
+
 def write(out, name, n_el, pads, args):
     """Write `<name>.toml` and its matrices for the given pads."""
     k, m = ring(n_el, args.radius, args.thickness, args.width, 210e9, 7850.0, args.hub_k)
@@ -201,49 +267,13 @@ def write(out, name, n_el, pads, args):
         f"# ({ndof_disc} dofs) and {len(pads)} pads ({2 * len(pads)} dofs). Do not edit: regenerate.",
         f'name = "{name}"',
         f'description = "An FE ring disc ({n_el} beam elements) with {len(pads)} pads, from Matrix Market files."',
-        'model = "lumped"',
-        "duration = 0.05",
-        "sample_rate = 200000.0",
-        'initial = "equilibrium"',
-        "dofs = [" + ", ".join(f'"{d}"' for d in names) + "]",
-        "",
-        "[params]                          # shared by the pads: --param mu=0.2:1.2 moves all",
-        f"mu = {fmt(args.mu)}",
-        f"Fb = {fmt(args.force)}",
-        "",
-        "[matrices]",
-        'M = "M.mtx"',
-        'K = "K.mtx"',
-        'C = "C.mtx"',
-    ]
+    ] + scenario_body(names, args.mu, args.force)
     for p in pads:
         node = p["node"]
         side = p["side"]  # +1: pad on the +w face, pressing towards -w
         pid = p["id"]
         surface = f"{{ {node}_1 = 1.0, {node}_5 = {fmt(-side * half)}, {pid}_1 = -1.0 }}"
-        if side > 0:
-            normal = f"{{ {node}_3 = 1.0, {pid}_3 = -1.0 }}"
-        else:
-            normal = f"{{ {pid}_3 = 1.0, {node}_3 = -1.0 }}"
-        lines += [
-            "",
-            "[[force]]",
-            f'name = "brake_{pid}"',
-            f"on = {{ {pid}_3 = 1.0 }}",
-            f'value = "{fmt(-side * p["force_share"])}*Fb"',
-            "",
-            "[[contact]]",
-            f'name = "{p["name"]}"',
-            f"normal = {normal}",
-            f"k = {fmt(p['k_contact'])}",
-            f"c = {fmt(p['c_contact'])}",
-            'contact = "unilateral"',
-            f"tangent = {surface}",
-            f"V = {fmt(args.speed)}",
-            'friction = "coulomb"',
-            f'mu_s = "{fmt(p["mu_ratio"] * 1.2)}*mu"',
-            f'mu_k = "{fmt(p["mu_ratio"])}*mu"',
-        ]
+        lines += pad_toml(p, f"{node}_3", surface, args.speed)
     text = "\n".join(lines) + "\n"
     with open(os.path.join(folder, "brake.toml"), "w") as f:
         f.write(text)
@@ -266,16 +296,7 @@ def main():
     ap.add_argument("--radius", type=float, default=0.15)
     ap.add_argument("--thickness", type=float, default=0.02)
     ap.add_argument("--width", type=float, default=0.05)
-    ap.add_argument("--hub-k", type=float, default=1.0e6)
-    ap.add_argument("--caliper-k", type=float, default=4.0e7)
-    ap.add_argument("--piston-k", type=float, default=5.0e7)
-    ap.add_argument("--incline", type=float, default=1.0, help="abutment angle (rad)")
-    ap.add_argument("--damping-a", type=float, default=2.0)
-    ap.add_argument("--damping-b", type=float, default=1.0e-8)
-    ap.add_argument("--mu", type=float, default=0.45)
-    ap.add_argument("--force", type=float, default=2000.0)
-    ap.add_argument("--speed", type=float, default=5.0)
-    ap.add_argument("--out", default=".")
+    add_brake_args(ap, hub_k=1.0e6)
     args = ap.parse_args()
     n = args.elements
 

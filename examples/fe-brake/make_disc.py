@@ -27,10 +27,14 @@ only on the arguments.
 import argparse
 import math
 import os
+import sys
 
 import numpy as np
 import scipy.io
 import scipy.sparse as sp
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_brake import add_brake_args, pad_toml, scenario_body  # noqa: E402  (the shared pad and options)
 
 GAUSS = np.array([-1.0, 1.0]) / math.sqrt(3.0)
 CORNERS = np.array(
@@ -123,10 +127,6 @@ def assemble(nodes, elems, e_mod, nu, rho):
     return k, m
 
 
-def fmt(x):
-    return repr(float(x))
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--ri", type=float, default=0.08)
@@ -135,20 +135,11 @@ def main():
     ap.add_argument("--radial", type=int, default=14)
     ap.add_argument("--circ", type=int, default=560)
     ap.add_argument("--layers", type=int, default=3)
-    ap.add_argument("--hub-k", type=float, default=1.0e8)
-    ap.add_argument("--caliper-k", type=float, default=4.0e7)
-    ap.add_argument("--piston-k", type=float, default=5.0e7)
-    ap.add_argument("--incline", type=float, default=1.0, help="abutment angle (rad)")
-    ap.add_argument("--damping-a", type=float, default=2.0)
-    ap.add_argument("--damping-b", type=float, default=1.0e-8)
-    ap.add_argument("--mu", type=float, default=0.45)
+    add_brake_args(ap, hub_k=1.0e8)
     ap.add_argument("--outer-mu-ratio", type=float, default=0.1,
                     help="the outer pad's friction coefficient as a fraction of mu (a glazed pad: the "
                     "asymmetry that makes this brake squeal; with equal pads their friction moments cancel)")
-    ap.add_argument("--force", type=float, default=2000.0)
-    ap.add_argument("--speed", type=float, default=5.0)
     ap.add_argument("--name", default=None)
-    ap.add_argument("--out", default=".")
     a = ap.parse_args()
     nodes, elems, nid = mesh(a.ri, a.ro, a.h, a.radial, a.circ, a.layers)
     k, m = assemble(nodes, elems, 210e9, 0.3, 7850.0)
@@ -163,8 +154,8 @@ def main():
     pm = sp.lil_matrix((4, 4))
     mid = int(round(a.radial / 2))
     pads = [
-        dict(name="inner", id=9000001, node=nid(a.layers, 0, mid) + 1, side=+1, k_contact=5.0e7, mu_ratio=1.0, mass=0.3, k_cal=a.caliper_k),
-        dict(name="outer", id=9000002, node=nid(0, 0, mid) + 1, side=-1, k_contact=4.0e7, mu_ratio=a.outer_mu_ratio, mass=0.35, k_cal=0.75 * a.caliper_k),
+        dict(name="inner", id=9000001, node=nid(a.layers, 0, mid) + 1, side=+1, k_contact=5.0e7, c_contact=0.0, mu_ratio=1.0, force_share=0.5, mass=0.3, k_cal=a.caliper_k),
+        dict(name="outer", id=9000002, node=nid(0, 0, mid) + 1, side=-1, k_contact=4.0e7, c_contact=0.0, mu_ratio=a.outer_mu_ratio, force_share=0.5, mass=0.35, k_cal=0.75 * a.caliper_k),
     ]
     ca, sa = math.cos(a.incline), math.sin(a.incline)
     for i, p in enumerate(pads):
@@ -191,43 +182,10 @@ def main():
         "# Do not edit: regenerate.",
         f'name = "{name}"',
         f'description = "An FE annular disc ({a.radial}x{a.circ}x{a.layers} hexahedra, {ndof} dofs) with 2 pads."',
-        'model = "lumped"',
-        "duration = 0.05",
-        "sample_rate = 200000.0",
-        'initial = "equilibrium"',
-        "dofs = [" + ", ".join(f'"{d}"' for d in names) + "]",
-        "",
-        "[params]",
-        f"mu = {fmt(a.mu)}",
-        f"Fb = {fmt(a.force)}",
-        "",
-        "[matrices]",
-        'M = "M.mtx"',
-        'K = "K.mtx"',
-        'C = "C.mtx"',
-    ]
+    ] + scenario_body(names, a.mu, a.force)
     for p in pads:
-        node, pid, side = p["node"], p["id"], p["side"]
-        normal = f"{{ {node}_3 = 1.0, {pid}_3 = -1.0 }}" if side > 0 else f"{{ {pid}_3 = 1.0, {node}_3 = -1.0 }}"
-        lines += [
-            "",
-            "[[force]]",
-            f'name = "brake_{pid}"',
-            f"on = {{ {pid}_3 = 1.0 }}",
-            f'value = "{fmt(-side * 0.5)}*Fb"',
-            "",
-            "[[contact]]",
-            f'name = "{p["name"]}"',
-            f"normal = {normal}",
-            f"k = {fmt(p['k_contact'])}",
-            "c = 0.0",
-            'contact = "unilateral"',
-            f"tangent = {{ {node}_2 = 1.0, {pid}_1 = -1.0 }}",
-            f"V = {fmt(a.speed)}",
-            'friction = "coulomb"',
-            f'mu_s = "{fmt(p["mu_ratio"] * 1.2)}*mu"',
-            f'mu_k = "{fmt(p["mu_ratio"])}*mu"',
-        ]
+        node, pid = p["node"], p["id"]
+        lines += pad_toml(p, f"{node}_3", f"{{ {node}_2 = 1.0, {pid}_1 = -1.0 }}", a.speed)
     with open(os.path.join(folder, "brake.toml"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print(f"{folder}: {ndof} dofs, K {kk.nnz} nonzeros")

@@ -124,7 +124,7 @@ pub fn coupled_modes(model: &AnyModel, an: &Analysis) -> Vec<CoupledMode> {
             at.truncate(3);
             CoupledMode {
                 eigenvalue: i,
-                composition: squeal_core::stability::coupling::composition_of(
+                composition: squeal_core::stability::coupling::composition(
                     &mass_times(q),
                     &basis,
                     q,

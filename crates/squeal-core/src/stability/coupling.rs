@@ -13,7 +13,7 @@
 //! instability is made of (at least) two real modes with comparable shares.
 
 use super::projected::UndampedBasis;
-use nalgebra::{Complex, DMatrix};
+use nalgebra::Complex;
 
 /// One real mode's share of a complex mode.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -37,24 +37,9 @@ pub struct Composition {
 }
 
 /// The real modes of `basis` that the complex mode shape `q` (length `n`)
-/// is made of, those with a share of at least `min_share`, at most `max`.
+/// is made of, those with a share of at least `min_share`, at most `max`;
+/// `mq` is `M q` (the caller multiplies: `M` dense or sparse).
 pub fn composition(
-    m: &DMatrix<f64>,
-    basis: &UndampedBasis,
-    q: &[Complex<f64>],
-    min_share: f64,
-    max: usize,
-) -> Composition {
-    let n = q.len();
-    // M q.
-    let mq: Vec<Complex<f64>> = (0..n)
-        .map(|i| (0..n).fold(Complex::new(0.0, 0.0), |s, j| s + q[j] * m[(i, j)]))
-        .collect();
-    composition_of(&mq, basis, q, min_share, max)
-}
-
-/// [`composition`] with `M q` given (`mq`, length `n`): for a sparse `M`.
-pub fn composition_of(
     mq: &[Complex<f64>],
     basis: &UndampedBasis,
     q: &[Complex<f64>],
@@ -93,6 +78,14 @@ pub fn composition_of(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::DMatrix;
+
+    fn mass_times(m: &DMatrix<f64>, q: &[Complex<f64>]) -> Vec<Complex<f64>> {
+        let n = q.len();
+        (0..n)
+            .map(|i| (0..n).fold(Complex::new(0.0, 0.0), |s, j| s + q[j] * m[(i, j)]))
+            .collect()
+    }
     use crate::stability::projected::{undamped_basis, Basis, SecondOrder};
 
     /// A 3-dof structure with a full mass matrix: a shape built from its
@@ -114,7 +107,7 @@ mod tests {
         let q: Vec<Complex<f64>> = (0..3)
             .map(|i| a * full.phi[(i, 0)] + b * full.phi[(i, 2)])
             .collect();
-        let c = composition(&m, &full, &q, 0.0, 5);
+        let c = composition(&mass_times(&m, &q), &full, &q, 0.0, 5);
         assert_eq!(c.shares[0].mode, 1);
         assert!((c.shares[0].share - 5.0 / 5.25).abs() < 1e-12);
         assert_eq!(c.shares[1].mode, 3);
@@ -127,7 +120,7 @@ mod tests {
         );
         // Two modes: mode 3 is outside; the basis holds 5 of 5.25.
         let two = undamped_basis(&sys, Basis::Modes(2)).unwrap();
-        let c = composition(&m, &two, &q, 0.01, 5);
+        let c = composition(&mass_times(&m, &q), &two, &q, 0.01, 5);
         assert_eq!(c.shares.len(), 1);
         assert!((c.shares[0].share - 1.0).abs() < 1e-12);
         assert!((c.captured - 5.0 / 5.25).abs() < 1e-12);
