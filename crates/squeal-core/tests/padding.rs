@@ -35,6 +35,8 @@ fn padded_sizes_cover_every_model_up_to_the_limit() {
     assert_eq!(padded_dofs(MAX_SIM_DOFS + 1), None);
     assert_eq!(padded_dofs(17), Some(24));
     assert_eq!(padded_dofs(64), Some(64));
+    assert_eq!(padded_dofs(65), Some(96));
+    assert_eq!(padded_dofs(128), Some(128));
 }
 
 /// The disc–pad at N = 2000 (stick-slip from rest, over 12 000 events in
@@ -158,4 +160,114 @@ fn a_20_dof_model_runs_padded_and_its_disc_pad_moves_as_alone() {
     }
     eprintln!("first 16 events: largest time difference {worst:e} s");
     assert!(worst <= 1e-9, "event times differ by up to {worst:e} s");
+}
+
+/// The default disc–pad's limit cycle (lumped, 4 dofs) found in its exact
+/// size and padded to 6 dofs: the Floquet analysis covers the real states
+/// only, so the padded cycle has the same period and start, the same
+/// number of multipliers (8, not 12: the idle dofs' would sit on the unit
+/// circle) and the same multipliers. The runs take the same steps, so the
+/// agreement is at round-off (1e-12 relative in the period, 1e-9 in each
+/// multiplier).
+#[test]
+fn a_padded_model_has_the_exact_size_cycle_and_multipliers() {
+    use squeal_core::cycle::{find_cycle, CycleOptions};
+    let lp = Lumped::build(&disc_pad_spec(&DiscPad::default())).unwrap();
+    let padded = lp.padded_to(6);
+    let opts = CycleOptions::default();
+    let mut popts = opts;
+    popts.solver = padded_solver::<12>(&opts.solver, 8);
+    let a = find_cycle(&lp, 0.0, [0.0; 8], &opts).unwrap();
+    let b = find_cycle(&padded, 0.0, [0.0; 12], &popts).unwrap();
+    assert!(
+        (a.period - b.period).abs() <= 1e-12 * a.period,
+        "{} vs {}",
+        a.period,
+        b.period
+    );
+    assert_eq!(b.multipliers.len(), 8);
+    assert_eq!(a.stable, b.stable);
+    for (x, y) in a.multipliers.iter().zip(&b.multipliers) {
+        assert_eq!(x.trivial, y.trivial);
+        assert!(
+            (x.re - y.re).abs() <= 1e-9 && (x.im - y.im).abs() <= 1e-9,
+            "{x:?} vs {y:?}"
+        );
+    }
+    let real = [0, 1, 2, 3, 6, 7, 8, 9];
+    for (k, &i) in real.iter().enumerate() {
+        assert!((a.z0[k] - b.z0[i]).abs() <= 1e-12 * a.amplitude[k].max(1e-30) + 1e-300);
+    }
+    for i in [4, 5, 10, 11] {
+        assert_eq!(b.z0[i], 0.0);
+        assert_eq!(b.amplitude[i], 0.0);
+    }
+    assert!(a.max_multiplier > 0.0 && (a.max_multiplier - b.max_multiplier).abs() <= 1e-9);
+}
+
+/// An 18-dof model run padded to 24 dofs: the default disc–pad plus 14
+/// separate oscillators at rest (mass `m`, spring `k_i` and damper `c_i` to
+/// ground). Its limit cycle is the disc–pad's, and its Floquet multipliers
+/// are exactly the disc–pad's 8 and, for each oscillator, `exp(λ T)` with
+/// `λ = −c/2m ± i √(k/m − (c/2m)²)`: 36 multipliers, each matched to 1e-6
+/// (the extra states change the error norm, so the steps and the round-off
+/// differ from the 4-dof run's; the period agrees to 1e-8 relative).
+#[test]
+fn an_18_dof_model_cycles_padded_with_the_exact_multipliers() {
+    use squeal_core::cycle::{find_cycle, CycleOptions};
+    let spec4 = disc_pad_spec(&DiscPad::default());
+    let small = Lumped::build(&spec4).unwrap();
+    let mut spec = spec4.clone();
+    let (m, extra) = (0.5, 14);
+    let mut expected = Vec::new();
+    for i in 1..=extra {
+        let name = format!("x{i}");
+        let (k, c) = (1.0e6 * i as f64, 20.0 * i as f64);
+        spec.dofs.push(name.clone());
+        spec.masses.push((name.clone(), m));
+        spec.springs.push(SpringSpec {
+            name: format!("ground{i}"),
+            on: vec![(name, 1.0)],
+            k,
+            c,
+        });
+        expected.push((-c / (2.0 * m), (k / m - (c / (2.0 * m)).powi(2)).sqrt()));
+    }
+    let big = Lumped::build(&spec).unwrap();
+    assert_eq!(padded_dofs(big.dof_count()), Some(24));
+    let padded = big.padded_to(24);
+    let opts = CycleOptions::default();
+    let a = find_cycle(&small, 0.0, [0.0; 8], &opts).unwrap();
+    let mut popts = opts;
+    popts.solver = padded_solver::<48>(&opts.solver, 36);
+    let b = find_cycle(&padded, 0.0, [0.0; 48], &popts).unwrap();
+    assert!(
+        (a.period - b.period).abs() <= 1e-8 * a.period,
+        "{} vs {}",
+        a.period,
+        b.period
+    );
+    assert_eq!(b.multipliers.len(), 36);
+    let mut want: Vec<(f64, f64)> = a.multipliers.iter().map(|m| (m.re, m.im)).collect();
+    for (re, im) in expected {
+        let (r, phase) = ((re * b.period).exp(), im * b.period);
+        want.push((r * phase.cos(), r * phase.sin()));
+        want.push((r * phase.cos(), -r * phase.sin()));
+    }
+    let mut got: Vec<(f64, f64)> = b.multipliers.iter().map(|m| (m.re, m.im)).collect();
+    for (re, im) in want {
+        let (k, d) = got
+            .iter()
+            .enumerate()
+            .map(|(k, g)| (k, (g.0 - re).hypot(g.1 - im)))
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+            .unwrap();
+        assert!(
+            d <= 1e-6,
+            "multiplier {re:+.9} {im:+.9}i: nearest off by {d:.2e}"
+        );
+        got.remove(k);
+    }
+    assert!((a.max_multiplier - b.max_multiplier).abs() <= 1e-6);
+    assert_eq!(a.stable, b.stable);
 }

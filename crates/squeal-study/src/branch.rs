@@ -87,7 +87,7 @@ pub fn follow(
         ..BranchOptions::default()
     };
     let mut settled = 0;
-    let out = crate::with_system!(&sc.model, m => {
+    let out = crate::with_sim_system!(&sc.model, m => {
         // The family checks the cancel token each time it builds a system,
         // so an interrupted continuation fails every step at once.
         let family = Varied { model: m, name };
@@ -153,11 +153,12 @@ type Collected = (
 fn collect<const N: usize>(b: &cont::Branch<N>, names: &[String]) -> Collected {
     let mut points = Vec::new();
     let mut curve = Vec::new();
+    let real = cycle::real_states::<N>(names.len());
     for p in &b.points {
         curve.push((
             p.segment,
             p.value,
-            p.cycle.amplitude.to_vec(),
+            real.iter().map(|&i| p.cycle.amplitude[i]).collect(),
             p.cycle.stable,
         ));
         let kind = match p.kind {

@@ -168,7 +168,9 @@ pub fn find<M: System<N> + ?Sized, const N: usize>(
         }
         None => cycle::find_cycle(m, 0.0, start, opts).map_err(cycle_err)?,
     };
-    let names = m.names();
+    // A padded model's idle states are not reported: the cycle reads as the real model's.
+    let real = real_states::<N>(m.norm_states());
+    let names = any.state_names();
     let orbit = if with_orbit {
         let o = cycle::orbit(m, &c, opts).map_err(cycle_err)?;
         let mut columns = vec!["t".to_string()];
@@ -180,7 +182,7 @@ pub fn find<M: System<N> + ?Sized, const N: usize>(
         let mut derived = Vec::new();
         for k in 0..o.t.len() {
             let mut row = vec![o.t[k]];
-            row.extend_from_slice(&o.z[k]);
+            row.extend(real.iter().map(|&i| o.z[k][i]));
             observe_all(m, o.t[k], &o.modes[k], &o.z[k], &mut obs);
             any.derived_values(&obs, &o.modes[k], &mut derived);
             row.extend_from_slice(&derived);
@@ -200,12 +202,28 @@ pub fn find<M: System<N> + ?Sized, const N: usize>(
     Ok(found)
 }
 
-/// The N-independent form of a located cycle (no orbit table).
+/// The indices of the `real` states of a model of `N` states (all of them,
+/// or a padded model's real ones: `squeal_core::model::lumped::padding`).
+pub fn real_states<const N: usize>(real: usize) -> Vec<usize> {
+    if real >= N {
+        (0..N).collect()
+    } else {
+        squeal_core::model::lumped::real_states::<N>(real / 2).collect()
+    }
+}
+
+/// The N-independent form of a located cycle (no orbit table): `names` are
+/// the model's real states (a padded model's idle ones are left out).
 pub fn found_of<const N: usize>(c: &cycle::Cycle<N>, names: Vec<String>) -> Found {
+    let real = real_states::<N>(names.len());
+    let section = real
+        .iter()
+        .position(|&i| i == c.section.index)
+        .map_or_else(String::new, |k| names[k].clone());
     Found {
         period: c.period,
-        z0: c.z0.to_vec(),
-        section: (names[c.section.index].clone(), c.section.level),
+        z0: real.iter().map(|&i| c.z0[i]).collect(),
+        section: (section, c.section.level),
         multipliers: c
             .multipliers
             .iter()
@@ -215,7 +233,7 @@ pub fn found_of<const N: usize>(c: &cycle::Cycle<N>, names: Vec<String>) -> Foun
         max_multiplier: c.max_multiplier,
         residual: c.residual,
         iterations: c.iterations,
-        amplitude: c.amplitude.to_vec(),
+        amplitude: real.iter().map(|&i| c.amplitude[i]).collect(),
         events: c.events_per_period,
         settle_time: c.settle_time,
         orbit: None,
@@ -233,7 +251,7 @@ pub fn of_scenario(
     cancel: &Cancel,
 ) -> Result<Found, StudyError> {
     cancel.check()?;
-    let found = crate::with_system!(&sc.model, m => {
+    let found = crate::with_sim_system!(&sc.model, m => {
         let z0 = crate::run::initial_of(m, sc)?;
         find(m, &sc.model, &z0, None, opts, with_orbit)
     }, else => Err(StudyError::Input(InputError(sc.model.check_cycle_size().err().unwrap_or_default()))));

@@ -1,6 +1,6 @@
 //! The models the command line knows, behind one enum, with their output columns.
 
-use squeal_core::model::lumped::{MAX_EXACT_DOFS, MAX_SIM_DOFS};
+use squeal_core::model::lumped::MAX_SIM_DOFS;
 use squeal_core::model::{Modes, Observables};
 use squeal_core::params::ParamKind;
 use squeal_core::stability::{self, Analysis, Inertia, StabilityError};
@@ -58,8 +58,10 @@ macro_rules! with_system {
 /// model of more than `MAX_EXACT_DOFS` (and at most `MAX_SIM_DOFS`) dofs runs
 /// padded with idle dofs (`squeal_core::model::lumped::padding`): run it
 /// with `run::sim_options` and `run::initial_of`, and read
-/// only its real states. Never for an eigen- or Floquet analysis (the idle
-/// dofs would add their modes).
+/// only its real states. Never for an eigen-analysis (the idle dofs would
+/// add their modes); `squeal_core::cycle`'s Floquet analysis leaves them out
+/// (it covers [`System::norm_states`](squeal_core::System::norm_states)), so
+/// `cycle` and `branch` use it too.
 #[macro_export]
 macro_rules! with_sim_system {
     ($any:expr, $m:ident => $body:expr, else => $fallback:expr) => {
@@ -190,11 +192,11 @@ impl AnyModel {
     }
     /// Whether the model's limit cycles can be analysed (`cycle`, `branch`:
     /// Floquet multipliers on fixed-size states; lumped: at most
-    /// `MAX_EXACT_DOFS` dofs).
+    /// `MAX_SIM_DOFS` dofs, as simulation).
     pub fn check_cycle_size(&self) -> Result<(), String> {
         match self {
-            AnyModel::Lumped(l) if l.dof_count() > MAX_EXACT_DOFS => Err(format!(
-                "this lumped model has {} dofs: cycle and branch support up to {MAX_EXACT_DOFS} dofs (simulate and map --transient up to {MAX_SIM_DOFS}; stability, map, critical and sweep any size)",
+            AnyModel::Lumped(l) if l.dof_count() > MAX_SIM_DOFS => Err(format!(
+                "this lumped model has {} dofs: cycle and branch support up to {MAX_SIM_DOFS} dofs, as simulate and map --transient (stability, map, critical and sweep any size; `squeal reduce` with a lower modal.cutoff_hz makes a smaller Craig–Bampton model of it)",
                 l.dof_count()
             )),
             _ => Ok(()),

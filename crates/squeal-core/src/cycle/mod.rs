@@ -157,9 +157,11 @@ pub struct Cycle<const N: usize> {
     pub z0: [f64; N],
     /// The section.
     pub section: Section,
-    /// The monodromy matrix `∂φ_T/∂z₀` (unscaled, row-major).
+    /// The monodromy matrix `∂φ_T/∂z₀` (unscaled, row-major; a padded
+    /// model's idle rows and columns are zero, see `real_indices`).
     pub monodromy: [[f64; N]; N],
-    /// All `N` multipliers sorted by modulus, descending; one is trivial.
+    /// All multipliers (one per state; a padded model's real states only)
+    /// sorted by modulus, descending; one is trivial.
     pub multipliers: Vec<Multiplier>,
     /// Whether every non-trivial multiplier lies inside the unit circle.
     pub stable: bool,
@@ -220,17 +222,19 @@ fn block_scales<const N: usize>(amp: &[f64; N], atol: &SolverOptions) -> [f64; N
 
 /// Jacobian `∂f/∂z` of the field of `modes` at `(t, z)` by central
 /// differences, in scaled coordinates `D⁻¹ J D` (step `1e-6` of each scale).
+/// Only the states `idx` (rows and columns; see [`real_indices`]).
 fn scaled_jacobian<S: System<N> + ?Sized, const N: usize>(
     sys: &S,
     t: f64,
     modes: &Modes,
     z: &[f64; N],
     s: &[f64; N],
+    idx: &[usize],
     out: &mut DMatrix<f64>,
 ) {
     let mut fp = [0.0; N];
     let mut fm = [0.0; N];
-    for j in 0..N {
+    for (c, &j) in idx.iter().enumerate() {
         let h = 1e-6 * s[j];
         let mut zp = *z;
         zp[j] += h;
@@ -239,9 +243,27 @@ fn scaled_jacobian<S: System<N> + ?Sized, const N: usize>(
         sys.field(t, modes, &zp, &mut fp);
         sys.field(t, modes, &zm, &mut fm);
         let dz = zp[j] - zm[j];
-        for i in 0..N {
-            out[(i, j)] = (fp[i] - fm[i]) / dz * s[j] / s[i];
+        for (r, &i) in idx.iter().enumerate() {
+            out[(r, c)] = (fp[i] - fm[i]) / dz * s[j] / s[i];
         }
+    }
+}
+
+/// The states a Floquet analysis covers: all `N`, or the real states of a
+/// model padded with idle dofs ([`crate::model::lumped::padding`], which
+/// reports its real state count as [`System::norm_states`]). The idle
+/// states are coupled to nothing and stay exactly at rest, so the
+/// monodromy matrix is block-diagonal: its real block is the real model's
+/// monodromy, and the idle block (a rotation at 1 rad/s) carries nothing
+/// of the orbit. It is left out of the variational equations, and the
+/// period matrix holds zeros there (an idle perturbation that dies at
+/// once: `M − I = −I` keeps the shooting matrix regular).
+fn real_indices<S: System<N> + ?Sized, const N: usize>(sys: &S) -> Vec<usize> {
+    let r = sys.norm_states();
+    if r >= N || r % 2 != 0 {
+        (0..N).collect()
+    } else {
+        crate::model::lumped::real_states::<N>(r / 2).collect()
     }
 }
 
@@ -272,6 +294,7 @@ fn guard_on<S: System<N> + ?Sized, const N: usize>(
 
 /// Saltation matrix (scaled) at an event from `modes_m` at `z_m` to
 /// `modes_p` at `z_p` (see the module documentation).
+#[allow(clippy::too_many_arguments)]
 fn saltation<S: System<N> + ?Sized, const N: usize>(
     sys: &S,
     t: f64,
@@ -280,14 +303,16 @@ fn saltation<S: System<N> + ?Sized, const N: usize>(
     modes_p: &Modes,
     z_p: &[f64; N],
     s: &[f64; N],
+    idx: &[usize],
 ) -> DMatrix<f64> {
+    let r = idx.len();
     let Some(g) = guard_on(sys, t, modes_m, z_m, s) else {
-        return DMatrix::identity(N, N);
+        return DMatrix::identity(r, r);
     };
     // P = ∂R/∂z by central differences of the reset map (exact for the
     // affine projections of the models here).
-    let mut p = DMatrix::<f64>::identity(N, N);
-    for j in 0..N {
+    let mut p = DMatrix::<f64>::identity(r, r);
+    for (c, &j) in idx.iter().enumerate() {
         let h = 1e-6 * s[j];
         let mut zp = *z_m;
         zp[j] += h;
@@ -295,8 +320,8 @@ fn saltation<S: System<N> + ?Sized, const N: usize>(
         zm[j] -= h;
         sys.switch(t, modes_m, &g, &mut zp);
         sys.switch(t, modes_m, &g, &mut zm);
-        for i in 0..N {
-            p[(i, j)] = (zp[i] - zm[i]) / (2.0 * h) * s[j] / s[i];
+        for (row, &i) in idx.iter().enumerate() {
+            p[(row, c)] = (zp[i] - zm[i]) / (2.0 * h) * s[j] / s[i];
         }
     }
     let mut fm = [0.0; N];
@@ -304,9 +329,9 @@ fn saltation<S: System<N> + ?Sized, const N: usize>(
     sys.field(t, modes_m, z_m, &mut fm);
     sys.field(t, modes_p, z_p, &mut fp);
     let grad = sys.guard_gradient(t, modes_m, &g, z_m);
-    let fm_s = DMatrix::from_fn(N, 1, |i, _| fm[i] / s[i]);
-    let fp_s = DMatrix::from_fn(N, 1, |i, _| fp[i] / s[i]);
-    let g_s = DMatrix::from_fn(1, N, |_, j| grad[j] * s[j]);
+    let fm_s = DMatrix::from_fn(r, 1, |i, _| fm[idx[i]] / s[idx[i]]);
+    let fp_s = DMatrix::from_fn(r, 1, |i, _| fp[idx[i]] / s[idx[i]]);
+    let g_s = DMatrix::from_fn(1, r, |_, j| grad[idx[j]] * s[idx[j]]);
     let rate = (&g_s * &fm_s)[(0, 0)];
     if rate == 0.0 || !rate.is_finite() {
         return p;
@@ -340,9 +365,11 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
 ) -> Result<Period<N>, CycleError> {
     let t_a = autonomous_from(sys);
     let mut solver = Solver::new(sys, t_a, *z0, t_a + period, opts.solver)?;
-    let mut phi = DMatrix::<f64>::identity(N, N);
-    let mut j1 = DMatrix::<f64>::zeros(N, N);
-    let mut j2 = DMatrix::<f64>::zeros(N, N);
+    let idx = real_indices(sys);
+    let r = idx.len();
+    let mut phi = DMatrix::<f64>::identity(r, r);
+    let mut j1 = DMatrix::<f64>::zeros(r, r);
+    let mut j2 = DMatrix::<f64>::zeros(r, r);
     let mut events = [0u64; 5];
     let mut last_switch: Option<(f64, [u64; 5], Modes)> = None;
     let mut lo = *z0;
@@ -368,6 +395,7 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
                 &seg.modes,
                 &solver.dense_at(seg.t0),
                 s,
+                &idx,
                 &mut j1,
             );
             scaled_jacobian(
@@ -376,10 +404,11 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
                 &seg.modes,
                 &solver.dense_at(seg.t1),
                 s,
+                &idx,
                 &mut j2,
             );
-            let var = (0..N)
-                .map(|i| (0..N).map(|j| (j2[(i, j)] - j1[(i, j)]).abs()).sum::<f64>())
+            let var = (0..r)
+                .map(|i| (0..r).map(|j| (j2[(i, j)] - j1[(i, j)]).abs()).sum::<f64>())
                 .fold(0.0, f64::max);
             // J's change over a substep is var/subs, times its length len/subs.
             let need = (len * var / MAGNUS_VARIATION).sqrt().ceil();
@@ -392,8 +421,8 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
             for k in 0..subs {
                 let a = seg.t0 + k as f64 * h;
                 let (ta, tb) = (a + (0.5 - g) * h, a + (0.5 + g) * h);
-                scaled_jacobian(sys, ta, &seg.modes, &solver.dense_at(ta), s, &mut j1);
-                scaled_jacobian(sys, tb, &seg.modes, &solver.dense_at(tb), s, &mut j2);
+                scaled_jacobian(sys, ta, &seg.modes, &solver.dense_at(ta), s, &idx, &mut j1);
+                scaled_jacobian(sys, tb, &seg.modes, &solver.dense_at(tb), s, &idx, &mut j2);
                 let omega = (&j1 + &j2) * (0.5 * h)
                     + (&j2 * &j1 - &j1 * &j2) * (3f64.sqrt() / 12.0 * h * h);
                 phi = omega.exp() * phi;
@@ -422,7 +451,7 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
             let z_p = *solver.state();
             let modes_p = solver.modes();
             if variational {
-                let sm = saltation(sys, seg.t1, &seg.modes, &z_m, &modes_p, &z_p, s);
+                let sm = saltation(sys, seg.t1, &seg.modes, &z_m, &modes_p, &z_p, s, &idx);
                 phi = sm * phi;
             }
             if let Some(o) = orbit.as_deref_mut() {
@@ -475,9 +504,21 @@ fn period_flow<S: System<N> + ?Sized, const N: usize>(
             "the monodromy matrix is not finite".into(),
         ));
     }
+    // The real block in place; an idle state's row and column stay zero.
+    let m = if r == N {
+        phi
+    } else {
+        let mut m = DMatrix::<f64>::zeros(N, N);
+        for (c, &j) in idx.iter().enumerate() {
+            for (row, &i) in idx.iter().enumerate() {
+                m[(i, j)] = phi[(row, c)];
+            }
+        }
+        m
+    };
     Ok(Period {
         z_end: *solver.state(),
-        m: phi,
+        m,
         events,
         lo,
         hi,
@@ -889,9 +930,20 @@ fn finish<S: System<N> + ?Sized, const N: usize>(
     let t_a = autonomous_from(sys);
     let modes = sys.start_modes(t_a, &z);
     sys.field(t_a, &modes, &z, &mut f);
-    let fs = nalgebra::DVector::from_fn(N, |i, _| f[i] / s[i]);
-    let k = section.index;
-    let (multipliers, max_multiplier) = multipliers_of(&p.m, &fs, k);
+    // The multipliers of the real states only (see `real_indices`).
+    let idx = real_indices(sys);
+    let fs = nalgebra::DVector::from_fn(idx.len(), |i, _| f[idx[i]] / s[idx[i]]);
+    let k = idx
+        .iter()
+        .position(|&i| i == section.index)
+        .ok_or_else(|| {
+            CycleError::Bad(format!(
+                "section state {} is an idle (padding) state",
+                section.index
+            ))
+        })?;
+    let m_real = p.m.select_rows(&idx).select_columns(&idx);
+    let (multipliers, max_multiplier) = multipliers_of(&m_real, &fs, k);
     let mut monodromy = [[0.0; N]; N];
     for i in 0..N {
         for j in 0..N {
@@ -902,7 +954,6 @@ fn finish<S: System<N> + ?Sized, const N: usize>(
     for i in 0..N {
         amplitude[i] = 0.5 * (p.hi[i] - p.lo[i]);
     }
-    let _ = sys;
     Ok(Cycle {
         period: t,
         z0: z,
@@ -1106,7 +1157,7 @@ pub fn return_map_multipliers<S: System<N> + ?Sized, const N: usize>(
                 ))
             })
     };
-    let idx: Vec<usize> = (0..N).filter(|&i| i != k).collect();
+    let idx: Vec<usize> = real_indices(sys).into_iter().filter(|&i| i != k).collect();
     let m = idx.len();
     let mut jac = DMatrix::<f64>::zeros(m, m);
     for (c, &j) in idx.iter().enumerate() {

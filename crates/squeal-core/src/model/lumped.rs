@@ -1554,7 +1554,7 @@ pub const MAX_MODEL_DOFS: usize = 1_000_000;
 /// fixed-size state arrays, so each size is compiled in — every size up to
 /// [`MAX_EXACT_DOFS`], then the padded sizes of [`PADDED_DOFS`] (see
 /// [`padding`]). Stability analysis works for any size.
-pub const MAX_SIM_DOFS: usize = 64;
+pub const MAX_SIM_DOFS: usize = 128;
 
 pub mod condense;
 mod folded;

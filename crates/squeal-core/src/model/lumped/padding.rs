@@ -15,9 +15,11 @@
 //! ([`System::norm_states`](crate::model::System::norm_states)), so a padded
 //! run takes the very steps of the unpadded one, bit for bit.
 //!
-//! Only simulation runs padded: an eigen-analysis of the padded model would
-//! add the idle dofs' modes (±i rad/s), so stability, cycles and their
-//! Floquet multipliers use the size-independent paths or the exact sizes.
+//! Simulation and limit cycles run padded. An eigen-analysis of the padded
+//! model would add the idle dofs' modes (±i rad/s), so stability uses the
+//! size-independent paths or the exact sizes; the Floquet analysis of
+//! `crate::cycle` covers the real states only (the monodromy matrix is
+//! block-diagonal, its real block the real model's).
 
 use super::{Combination, Lumped, Sparse, Spring};
 use crate::solver_options::{SolverOptions, MAX_STATES};
@@ -26,7 +28,7 @@ use crate::solver_options::{SolverOptions, MAX_STATES};
 pub const MAX_EXACT_DOFS: usize = 16;
 
 /// The padded sizes (dofs) a larger model runs in, smallest first.
-pub const PADDED_DOFS: [usize; 4] = [24, 32, 48, 64];
+pub const PADDED_DOFS: [usize; 6] = [24, 32, 48, 64, 96, 128];
 
 /// Prefix of the idle dofs' names (`pad.1`, …): a `.` is not allowed in a
 /// user's dof name, so they never collide.
@@ -165,6 +167,16 @@ macro_rules! with_padded_size {
             Some(64) => {
                 let p = l.padded_to(64);
                 let $m = &Fixed::<128>(&p);
+                $body
+            }
+            Some(96) => {
+                let p = l.padded_to(96);
+                let $m = &Fixed::<192>(&p);
+                $body
+            }
+            Some(128) => {
+                let p = l.padded_to(128);
+                let $m = &Fixed::<256>(&p);
                 $body
             }
             _ => $fallback,
