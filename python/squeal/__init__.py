@@ -41,6 +41,7 @@ __all__ = [
     "critical",
     "cycle",
     "inspect",
+    "listen",
     "map",
     "reduce",
     "reproduce",
@@ -473,6 +474,83 @@ def reduce(
     if out is not None:
         _write_new_folder(os.fspath(out), files)
     return doc
+
+
+def listen(
+    scenario: Scenario = "disc-pad",
+    *,
+    out: Optional[Union[str, "os.PathLike[str]"]] = None,
+    signal: Optional[str] = None,
+    gain: float = 0.0,
+    transpose: float = 0.0,
+    float32: bool = False,
+    force: bool = False,
+    duration: Optional[float] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
+) -> Dict[str, Any]:
+    """A run as sound (``squeal listen``): the scenario simulated and one
+    velocity rendered at true pitch, 48 kHz, at a fixed level reference —
+    full scale is ``full_scale_m_per_s`` (2 m/s) at ``gain`` 0 dB, no
+    normalisation, so a brake that vibrates ten times as fast sounds 20 dB
+    louder.
+
+    ``signal``: the velocity column to hear (default: the one that
+    squeals, else the one with the most energy); ``gain`` in dB (within
+    ±200); ``transpose`` in octaves (within ±6; a listening aid, not the
+    true pitch). Returns a dict: ``samples`` (float32 array in [-1, 1]),
+    ``sample_rate`` (Hz), ``seconds`` (s), ``signal``, ``rms_dbfs`` (dB re
+    full scale), ``clipped_samples``, ``looped`` (the run was shorter than
+    the clip and its last fifth was looped), ``source_seconds`` (s),
+    ``verdict``, ``squeal_hz`` (Hz or None), ``level`` and ``note`` (the
+    lines ``squeal listen`` prints), and ``wav`` (the file's bytes: 16-bit
+    PCM, or 32-bit float with ``float32``). With ``out``, the WAV is also
+    written there — the very bytes ``squeal listen --out`` writes — never
+    over an existing file unless ``force``; it is written beside ``out``
+    and renamed into place, so an interrupted call leaves nothing.
+    ``IPython.display.Audio(r["samples"], rate=r["sample_rate"],
+    normalize=False)`` plays it in a notebook.
+    """
+    name = os.path.basename(os.fspath(out)) if out is not None else "squeal.wav"
+    if out is not None:
+        path = os.fspath(out)
+        if os.path.lexists(path) and not force:
+            raise ScenarioError(f"out = {path!r}: exists; pass force=True to replace it")
+        parent = os.path.dirname(os.path.abspath(path))
+        if not os.path.isdir(parent):
+            raise ScenarioError(f"out = {path!r}: its folder {parent!r} does not exist")
+    raw = _squeal.listen(
+        *_source(scenario), _sets(set, params), duration, signal,
+        float(gain), float(transpose), bool(float32), name,
+    )
+    if out is not None:
+        _write_file(os.fspath(out), raw["wav"], force)
+    return raw
+
+
+def _write_file(path: str, data: bytes, force: bool) -> None:
+    """Write ``data`` to ``path``: staged beside it and renamed into place
+    (an interrupted call leaves nothing); an existing file is replaced only
+    with ``force`` (without it, a file that appeared meanwhile is kept)."""
+    import tempfile
+
+    parent = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".squeal-", suffix=".wav", dir=parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        if force:
+            os.replace(tmp, path)
+        else:
+            os.link(tmp, path)
+            os.unlink(tmp)
+    except FileExistsError:
+        os.unlink(tmp)
+        raise ScenarioError(f"out = {path!r}: exists; pass force=True to replace it") from None
+    except BaseException:
+        if os.path.lexists(tmp):
+            os.unlink(tmp)
+        raise
 
 
 def _write_new_folder(out: str, files: Mapping[str, str]) -> None:

@@ -579,6 +579,67 @@ fn reduce<'py>(
     Ok(out)
 }
 
+/// A run as sound (`squeal listen`): the scenario simulated, a velocity
+/// (`signal`, default the squealing one) rendered at 48 kHz at the fixed
+/// level reference, its samples (float32 in [-1, 1]), the WAV file's bytes
+/// (`wav`, as `squeal listen` writes them, named `file_name` in its
+/// comment), and what the terminal would say.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn listen<'py>(
+    py: Python<'py>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    duration: Option<f64>,
+    signal: Option<String>,
+    gain: f64,
+    transpose: f64,
+    float: bool,
+    file_name: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let sound =
+        squeal_study::audio::SoundSettings::checked(gain, transpose, ("gain = ", "transpose = "))
+            .map_err(|e| study_err(e.into()))?;
+    let sc = with_source(kind, text, |s| {
+        squeal_study::feasible::resolve_run(s, &sets, duration)
+    })?;
+    let (name, clip, judgement) = compute(py, |cancel| {
+        let run = squeal_study::run::run(&sc, &NoProgress, cancel)?;
+        squeal_study::audio::listen(
+            &run,
+            sc.validity,
+            signal.as_deref(),
+            &sc.model.channels().tangential,
+            &sound,
+            "signal = ",
+        )
+    })?;
+    let out = PyDict::new(py);
+    out.set_item("signal", &name)?;
+    out.set_item("sample_rate", clip.sample_rate)?;
+    out.set_item("seconds", clip.duration())?;
+    out.set_item("looped", clip.looped)?;
+    out.set_item("source_seconds", clip.source_seconds)?;
+    out.set_item("rms_dbfs", clip.rms_dbfs)?;
+    out.set_item("clipped_samples", clip.clipped)?;
+    out.set_item("full_scale_m_per_s", squeal_study::audio::FULL_SCALE)?;
+    out.set_item("verdict", judgement.verdict.to_string())?;
+    out.set_item(
+        "squeal_hz",
+        judgement.squeal.as_ref().map(|q| q.frequency_hz),
+    )?;
+    out.set_item("level", sound.describe(&clip))?;
+    out.set_item(
+        "note",
+        squeal_study::audio::hearing_note(&judgement, &sound),
+    )?;
+    let wav = squeal_study::audio::wav_bytes(&clip, float, file_name, &sound);
+    out.set_item("wav", pyo3::types::PyBytes::new(py, &wav))?;
+    out.set_item("samples", clip.samples.into_pyarray(py))?;
+    Ok(out)
+}
+
 /// A limit cycle (`squeal cycle --json`): the document as JSON text, and the
 /// orbit over one period (column names, rows × columns, event kinds per row).
 #[pyfunction]
@@ -672,6 +733,7 @@ fn _squeal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add_function(wrap_pyfunction!(inspect, m)?)?;
     m.add_function(wrap_pyfunction!(reduce, m)?)?;
+    m.add_function(wrap_pyfunction!(listen, m)?)?;
     m.add_function(wrap_pyfunction!(reproduce, m)?)?;
     Ok(())
 }

@@ -351,3 +351,38 @@ def test_reproduce_equals_the_clis_table_and_conclusions(cli, tmp_path):
     assert [c["id"] for c in r["conclusions"]] == list(range(1, 8))
     with pytest.raises(squeal.ScenarioError, match="duration"):
         squeal.reproduce(duration_scale=-1.0)
+
+
+def test_listen_writes_the_cli_wav_bytes_and_returns_its_samples(cli, tmp_path):
+    # The same scenario through `squeal listen --out a/s.wav` and
+    # `squeal.listen(out=b/s.wav)` (the comment chunk names the file): the
+    # very same bytes; the samples are the file's (16-bit PCM of the float32
+    # samples); the stated RMS level is the samples'.
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    cli("listen", "disc-pad", "--set", "N=2000", "--set", "duration=0.05",
+        "--out", str(tmp_path / "a" / "s.wav"))
+    r = squeal.listen("disc-pad", out=tmp_path / "b" / "s.wav", N=2000, set={"duration": 0.05})
+    written = (tmp_path / "b" / "s.wav").read_bytes()
+    assert written == (tmp_path / "a" / "s.wav").read_bytes()
+    assert r["wav"] == written
+    s = r["samples"]
+    assert s.dtype == np.float32 and r["sample_rate"] == 48000
+    assert abs(len(s) / 48000 - r["seconds"]) < 1e-12
+    start = written.index(b"data") + 8
+    pcm = np.frombuffer(written[start:start + 2 * len(s)], dtype="<i2").astype(np.float64)
+    assert np.max(np.abs(pcm - np.round(np.clip(s, -1, 1) * 32767.0))) == 0
+    rms_db = 10 * np.log10(np.mean(s.astype(np.float64) ** 2))
+    assert abs(rms_db - r["rms_dbfs"]) < 1e-3
+    assert r["signal"].startswith("v") and r["verdict"]
+    # Never over an existing file unless asked; nothing left behind.
+    with pytest.raises(squeal.ScenarioError, match="exists"):
+        squeal.listen("disc-pad", out=tmp_path / "b" / "s.wav", N=2000, set={"duration": 0.05})
+    quieter = squeal.listen("disc-pad", out=tmp_path / "b" / "s.wav", force=True, gain=-6.0,
+                            N=2000, set={"duration": 0.05})
+    assert abs(quieter["rms_dbfs"] - (r["rms_dbfs"] - 6.0)) < 0.01
+    assert [p.name for p in (tmp_path / "b").iterdir()] == ["s.wav"]
+    with pytest.raises(squeal.ScenarioError, match="gain"):
+        squeal.listen("disc-pad", gain=500.0)
+    with pytest.raises(squeal.ScenarioError, match="signal = nope"):
+        squeal.listen("disc-pad", signal="nope", set={"duration": 0.01})

@@ -9,6 +9,7 @@
 
 pub mod analysis;
 pub mod answer;
+pub mod audio;
 pub mod branch;
 pub mod cpu;
 pub mod critical;

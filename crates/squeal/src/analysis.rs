@@ -5,10 +5,9 @@
 pub use squeal_study::analysis::*;
 
 use crate::run::{Run, RunError};
-use serde_json::{json, Value};
 use squeal_plot::{Format, HeatmapSpec, Labels, Panel, Series};
+use squeal_signal::spectrogram;
 use squeal_signal::spectrum::Scaling;
-use squeal_signal::{spectrogram, Judgement};
 use squeal_study::model::Channels;
 use squeal_study::scenario::InputError;
 use std::fmt::Write as _;
@@ -476,117 +475,10 @@ pub fn draw(
     Ok(left_out)
 }
 
-/// The level reference of every WAV squeal writes: a velocity of
-/// `FULL_SCALE` m/s is full scale (sample value 1) at `--gain 0`. No
-/// normalisation: a run that vibrates ten times as fast sounds 20 dB louder.
-pub const FULL_SCALE: f64 = 2.0;
+pub use squeal_study::audio::{default_sound_signal, hearing_note, SoundSettings};
 
-/// Frequencies above this (Hz) most adults do not hear.
-pub const HEARING_LIMIT_HZ: f64 = 16_000.0;
-
-/// How a WAV is rendered: the gain on top of [`FULL_SCALE`] and a listening
-/// transposition.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct SoundSettings {
-    /// Gain in dB (0: full scale = [`FULL_SCALE`] m/s).
-    pub gain_db: f64,
-    /// Transposition in octaves (0: true pitch).
-    pub transpose_octaves: f64,
-}
-
-impl SoundSettings {
-    /// From `--gain` and `--transpose`, checked.
-    pub fn from_flags(gain_db: f64, transpose: f64) -> Result<Self, InputError> {
-        if !(gain_db.is_finite() && gain_db.abs() <= 200.0) {
-            return Err(InputError(format!(
-                "--gain {gain_db}: must be a number of dB within ±200"
-            )));
-        }
-        if !(transpose.is_finite() && transpose.abs() <= 6.0) {
-            return Err(InputError(format!(
-                "--transpose {transpose}: must be a number of octaves within ±6"
-            )));
-        }
-        Ok(SoundSettings {
-            gain_db,
-            transpose_octaves: transpose,
-        })
-    }
-    /// The line that says how loud the file is and why, for the terminal.
-    pub fn describe(&self, clip: &squeal_signal::AudioClip) -> String {
-        let mut s = format!(
-            "level: full scale = {FULL_SCALE} m/s at gain {:+.1} dB (no normalisation); RMS {:.1} dB re full scale",
-            self.gain_db, clip.rms_dbfs
-        );
-        if self.transpose_octaves != 0.0 {
-            let _ = write!(
-                s,
-                "; TRANSPOSED {:+} octaves (a listening aid, not the true pitch)",
-                self.transpose_octaves
-            );
-        }
-        if clip.clipped > 0 {
-            let _ = write!(
-                s,
-                "; {} samples clipped: lower --gain by {:.0} dB",
-                clip.clipped,
-                (20.0 * (1.0 / clip.gain.max(1e-300)).log10())
-                    .max(6.0)
-                    .ceil()
-            );
-        }
-        s
-    }
-    /// The same as JSON (`audio` in summary.json).
-    pub fn json(&self, signal: &str, clip: &squeal_signal::AudioClip) -> Value {
-        json!({
-            "signal": signal,
-            "full_scale_m_per_s": FULL_SCALE,
-            "gain_db": self.gain_db,
-            "transpose_octaves": self.transpose_octaves,
-            "rms_dbfs": clip.rms_dbfs,
-            "clipped_samples": clip.clipped,
-            "sample_rate": clip.sample_rate,
-            "seconds": clip.duration(),
-        })
-    }
-}
-
-/// The velocity to hear by default: the squealing one, else the state's
-/// velocity with the most energy (largest RMS over the judged window).
-pub fn default_sound_signal(run: &Run, j: &Judgement) -> Option<String> {
-    if let Some(q) = &j.squeal {
-        return Some(q.velocity.clone());
-    }
-    let pairs = state_pairs(run);
-    j.trends
-        .iter()
-        .filter(|t| t.rms > 0.0)
-        .max_by(|a, b| a.rms.total_cmp(&b.rms))
-        .and_then(|t| pairs.iter().find(|p| p.0 == t.name).map(|p| p.1.clone()))
-        .or_else(|| pairs.first().map(|p| p.1.clone()))
-}
-
-/// A note when the squeal is above most adults' hearing, offering the
-/// listening aid.
-pub fn hearing_note(j: &Judgement, sound: &SoundSettings) -> Option<String> {
-    let q = j.squeal.as_ref()?;
-    if q.frequency_hz <= HEARING_LIMIT_HZ || sound.transpose_octaves != 0.0 {
-        return None;
-    }
-    Some(format!(
-        "note: the squeal ({}) is above most adults' hearing (about {}); to hear what the brake does, \
-         render it two octaves lower with --transpose -2 (at {}; a listening aid, not the true pitch)",
-        si(q.frequency_hz, "Hz", 4),
-        si(HEARING_LIMIT_HZ, "Hz", 2),
-        si(q.frequency_hz / 4.0, "Hz", 4)
-    ))
-}
-
-/// Render a velocity column as a WAV file (16-bit PCM or 32-bit float, 48 kHz)
-/// at the fixed level reference ([`FULL_SCALE`], `sound.gain_db`), at true
-/// pitch unless transposed. The resampler passes up to 22 kHz, so the disc–pad
-/// squeal at 20.75 kHz is in the file, not filtered out.
+/// Render a velocity column as a WAV file at `path`
+/// ([`squeal_study::audio::render`] and [`squeal_study::audio::wav_bytes`]).
 pub fn write_wav(
     x: &[f64],
     fs: f64,
@@ -594,78 +486,12 @@ pub fn write_wav(
     float: bool,
     sound: &SoundSettings,
 ) -> Result<squeal_signal::AudioClip, RunError> {
-    // Loop the last fifth: the part the verdict judges steady (the last half of
-    // a squeal run often still holds its growth or the pad's saturation).
-    let opts = squeal_signal::AudioOptions {
-        loop_fraction: 0.2,
-        full_scale: Some(FULL_SCALE),
-        gain_db: sound.gain_db,
-        transpose_octaves: sound.transpose_octaves,
-        resampler: squeal_signal::ResampleOptions {
-            passband_hz: 22_000.0,
-            stopband_hz: 24_000.0,
-            ..squeal_signal::ResampleOptions::default()
-        },
-        ..squeal_signal::AudioOptions::default()
-    };
-    let clip = squeal_signal::render_audio(x, fs, &opts)
-        .map_err(|e| RunError::Io(format!("audio rendering failed: {e}")))?;
-    let spec = hound::WavSpec {
-        channels: 1,
-        sample_rate: clip.sample_rate,
-        bits_per_sample: if float { 32 } else { 16 },
-        sample_format: if float {
-            hound::SampleFormat::Float
-        } else {
-            hound::SampleFormat::Int
-        },
-    };
-    let io = |e: hound::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
-    let mut w = hound::WavWriter::create(path, spec).map_err(io)?;
-    for &s in &clip.samples {
-        if float {
-            w.write_sample(s).map_err(io)?;
-        } else {
-            w.write_sample((s.clamp(-1.0, 1.0) * 32767.0).round() as i16)
-                .map_err(io)?;
-        }
-    }
-    w.finalize().map_err(io)?;
-    let comment = format!(
-        "squeal: {}; full scale = {FULL_SCALE} m/s at gain {:+.1} dB; transposed {:+} octaves",
-        path.file_name()
-            .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
-        sound.gain_db,
-        sound.transpose_octaves
-    );
-    append_wav_comment(path, &comment)
+    let clip = squeal_study::audio::render(x, fs, sound).map_err(RunError::Io)?;
+    let name = path
+        .file_name()
+        .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+    let bytes = squeal_study::audio::wav_bytes(&clip, float, &name, sound);
+    std::fs::write(path, bytes)
         .map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))?;
     Ok(clip)
-}
-
-/// Append a RIFF `LIST`/`INFO` chunk with an `ICMT` (comment) entry to a WAV
-/// file and fix the RIFF size: players show it as the file's comment.
-fn append_wav_comment(path: &Path, text: &str) -> std::io::Result<()> {
-    use std::io::{Seek, SeekFrom, Write};
-    let mut body = text.as_bytes().to_vec();
-    body.push(0);
-    if body.len() % 2 == 1 {
-        body.push(0);
-    }
-    let mut chunk = Vec::with_capacity(body.len() + 20);
-    chunk.extend_from_slice(b"LIST");
-    chunk.extend_from_slice(&((4 + 8 + body.len()) as u32).to_le_bytes());
-    chunk.extend_from_slice(b"INFO");
-    chunk.extend_from_slice(b"ICMT");
-    chunk.extend_from_slice(&(body.len() as u32).to_le_bytes());
-    chunk.extend_from_slice(&body);
-    let mut f = std::fs::OpenOptions::new()
-        .read(true)
-        .write(true)
-        .open(path)?;
-    let len = f.seek(SeekFrom::End(0))?;
-    f.write_all(&chunk)?;
-    f.seek(SeekFrom::Start(4))?;
-    f.write_all(&((len + chunk.len() as u64 - 8) as u32).to_le_bytes())?;
-    f.flush()
 }

@@ -61,24 +61,21 @@ pub fn run(a: ListenArgs) -> Result<(), RunError> {
         let sc = crate::commands::simulate::resolve_run(&a.scenario, None)?;
         (run::run(&sc)?, sc.model.name().to_string(), sc.validity)
     };
-    let judgement = analysis::judge_run(&run, validity);
-    let name = a.signal.clone().unwrap_or_else(|| {
-        analysis::default_sound_signal(&run, &judgement)
-            .unwrap_or_else(|| channels_for(&model).tangential.to_string())
-    });
-    let x = run.column(&name).ok_or_else(|| {
-        let vels: Vec<&str> = run
-            .columns
-            .iter()
-            .filter(|c| c.starts_with('v') && *c != "v_rel")
-            .map(String::as_str)
-            .collect();
-        InputError(format!(
-            "--signal {name}: no such signal (velocities: {})",
-            vels.join(", ")
-        ))
-    })?;
-    let clip = analysis::write_wav(x, run.sample_rate, staged.path(), a.float, &sound)?;
+    let (name, clip, judgement) = squeal_study::audio::listen(
+        &run,
+        validity,
+        a.signal.as_deref(),
+        &channels_for(&model).tangential,
+        &sound,
+        "--signal ",
+    )?;
+    let file_name = a
+        .out
+        .file_name()
+        .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+    let bytes = squeal_study::audio::wav_bytes(&clip, a.float, &file_name, &sound);
+    std::fs::write(staged.path(), bytes)
+        .map_err(|e| RunError::Io(format!("cannot write {}: {e}", staged.path().display())))?;
     staged.commit("--out")?;
     if clip.looped {
         crate::errln!(
