@@ -1,7 +1,7 @@
 //! Friction laws μ(v) of the sliding speed v ≥ 0, each with its slope dμ/dv
 //! and its static coefficient μ_s (the bound on the stick force, μ_s ≥ μ(0+)).
 //!
-//! Laws are selected by name (`thesis`, `coulomb`, `stribeck`, `rational`) and
+//! Laws are selected by name (`thesis`, `coulomb`, `stribeck`, `rational`, `tanh`) and
 //! their parameters are addressed by the ASCII names of MODEL.md §3, so that a
 //! scenario can switch laws and keep the parameters the two laws share.
 
@@ -50,10 +50,24 @@ pub enum FrictionLaw {
         /// Decay coefficient δ (s/m).
         delta: f64,
     },
+    /// Regularised Coulomb friction, `μ(v) = μ_k·tanh(v/ε)`: smooth and odd
+    /// in the signed sliding speed, so it never sticks (its static
+    /// coefficient is `μ(0) = 0`: a contact at zero sliding speed with any
+    /// tangential load slides on). The law of NLvib's friction examples
+    /// (Krack & Gross 2019, *Harmonic Balance for Nonlinear Vibration
+    /// Problems*, §2) and of many harmonic-balance codes; exact Coulomb
+    /// friction is its limit `ε → 0`, at the cost of a slope `μ_k/ε` at
+    /// `v = 0` that makes the motion stiff.
+    Tanh {
+        /// Kinetic coefficient (the limit at `|v| ≫ ε`).
+        mu_k: f64,
+        /// Regularisation speed ε (m/s).
+        eps: f64,
+    },
 }
 
 /// Names of the friction laws, as typed by users.
-pub const LAW_NAMES: [&str; 4] = ["thesis", "coulomb", "stribeck", "rational"];
+pub const LAW_NAMES: [&str; 5] = ["thesis", "coulomb", "stribeck", "rational", "tanh"];
 
 const THESIS_PARAMS: &[ParamSpec] = &[
     ParamSpec::new(
@@ -131,6 +145,21 @@ const RATIONAL_PARAMS: &[ParamSpec] = &[
     ),
 ];
 
+const TANH_PARAMS: &[ParamSpec] = &[
+    ParamSpec::new(
+        "mu_k",
+        "1",
+        "kinetic friction coefficient (μ = mu_k·tanh(v/eps))",
+        ParamKind::NonNegative,
+    ),
+    ParamSpec::new(
+        "eps",
+        "m/s",
+        "regularisation speed of μ = mu_k·tanh(v/eps)",
+        ParamKind::Positive,
+    ),
+];
+
 impl Default for FrictionLaw {
     /// The thesis law with MODEL.md's defaults: f0 = 0.1, f1 = 1/15 s/m, Uc = 50/3 m/s.
     fn default() -> Self {
@@ -167,6 +196,10 @@ impl FrictionLaw {
                 mu_s: 0.1,
                 delta: 0.5,
             },
+            "tanh" => FrictionLaw::Tanh {
+                mu_k: 0.08,
+                eps: 1e-3,
+            },
             _ => {
                 return Err(ParamError::BadChoice {
                     key: "friction".into(),
@@ -195,6 +228,7 @@ impl FrictionLaw {
             FrictionLaw::Coulomb { .. } => "coulomb",
             FrictionLaw::Stribeck { .. } => "stribeck",
             FrictionLaw::Rational { .. } => "rational",
+            FrictionLaw::Tanh { .. } => "tanh",
         }
     }
 
@@ -205,6 +239,7 @@ impl FrictionLaw {
             FrictionLaw::Coulomb { .. } => COULOMB_PARAMS,
             FrictionLaw::Stribeck { .. } => STRIBECK_PARAMS,
             FrictionLaw::Rational { .. } => RATIONAL_PARAMS,
+            FrictionLaw::Tanh { .. } => TANH_PARAMS,
         }
     }
 
@@ -218,7 +253,9 @@ impl FrictionLaw {
             | (FrictionLaw::Stribeck { mu_s, .. }, "mu_s")
             | (FrictionLaw::Rational { mu_s, .. }, "mu_s") => Some(mu_s),
             (FrictionLaw::Coulomb { mu_k, .. }, "mu_k")
-            | (FrictionLaw::Stribeck { mu_k, .. }, "mu_k") => Some(mu_k),
+            | (FrictionLaw::Stribeck { mu_k, .. }, "mu_k")
+            | (FrictionLaw::Tanh { mu_k, .. }, "mu_k") => Some(mu_k),
+            (FrictionLaw::Tanh { eps, .. }, "eps") => Some(eps),
             (FrictionLaw::Stribeck { v_s, .. }, "v_s") => Some(v_s),
             (FrictionLaw::Stribeck { delta, .. }, "delta")
             | (FrictionLaw::Rational { delta, .. }, "delta") => Some(delta),
@@ -244,7 +281,9 @@ impl FrictionLaw {
             | (FrictionLaw::Stribeck { mu_s, .. }, "mu_s")
             | (FrictionLaw::Rational { mu_s, .. }, "mu_s") => *mu_s = value,
             (FrictionLaw::Coulomb { mu_k, .. }, "mu_k")
-            | (FrictionLaw::Stribeck { mu_k, .. }, "mu_k") => *mu_k = value,
+            | (FrictionLaw::Stribeck { mu_k, .. }, "mu_k")
+            | (FrictionLaw::Tanh { mu_k, .. }, "mu_k") => *mu_k = value,
+            (FrictionLaw::Tanh { eps, .. }, "eps") => *eps = value,
             (FrictionLaw::Stribeck { v_s, .. }, "v_s") => *v_s = value,
             (FrictionLaw::Stribeck { delta, .. }, "delta")
             | (FrictionLaw::Rational { delta, .. }, "delta") => *delta = value,
@@ -306,6 +345,7 @@ impl FrictionLaw {
                 sigma,
             } => mu_k + (mu_s - mu_k) * (-(v.abs() / v_s).powf(delta)).exp() + sigma * v,
             FrictionLaw::Rational { mu_s, delta } => mu_s / (1.0 + delta * v),
+            FrictionLaw::Tanh { mu_k, eps } => mu_k * (v / eps).tanh(),
         }
     }
 
@@ -339,6 +379,11 @@ impl FrictionLaw {
             FrictionLaw::Rational { mu_s, delta } => {
                 let d = 1.0 + delta * v;
                 -mu_s * delta / (d * d)
+            }
+            FrictionLaw::Tanh { mu_k, eps } => {
+                // sech² = 1 − tanh², exact to round-off and finite for any v.
+                let t = (v / eps).tanh();
+                mu_k / eps * (1.0 - t * t)
             }
         }
     }
@@ -389,6 +434,8 @@ impl FrictionLaw {
                     (mu_s.abs() / d0, mu_s.abs() * delta / (d0 * d0))
                 }
             }
+            // |tanh| ≤ 1 and sech² ≤ 1 everywhere.
+            FrictionLaw::Tanh { mu_k, eps } => (mu_k.abs(), mu_k.abs() / eps),
         }
     }
 
@@ -400,6 +447,7 @@ impl FrictionLaw {
             FrictionLaw::Coulomb { mu_s, .. }
             | FrictionLaw::Stribeck { mu_s, .. }
             | FrictionLaw::Rational { mu_s, .. } => mu_s,
+            FrictionLaw::Tanh { .. } => 0.0,
         }
     }
 }
@@ -448,6 +496,10 @@ mod tests {
             FrictionLaw::by_name("coulomb").unwrap(),
             FrictionLaw::by_name("stribeck").unwrap(),
             FrictionLaw::by_name("rational").unwrap(),
+            FrictionLaw::Tanh {
+                mu_k: 0.3,
+                eps: 0.5,
+            },
         ];
         for law in laws {
             for v in [0.05, 0.7, 2.0, 9.0] {

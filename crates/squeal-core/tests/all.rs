@@ -20,3 +20,4 @@ mod projected;
 mod stability;
 mod steady;
 mod sweep;
+mod tanh;

@@ -112,7 +112,7 @@ fn jacobians_match_central_differences() {
     }
 
     // Belt: x* = μN/k ≈ 1e-3 m.
-    for law in ["thesis", "stribeck", "rational"] {
+    for law in ["thesis", "stribeck", "rational", "tanh"] {
         let mut b = Belt {
             friction: FrictionLaw::by_name(law).unwrap(),
             ..Belt::default()

@@ -45,7 +45,7 @@ impl LaneLaw {
             FrictionLaw::Thesis { f0, f1, uc } => [f0, f1, 2.0 * uc],
             FrictionLaw::Coulomb { mu_k, .. } => [mu_k, 0.0, 0.0],
             FrictionLaw::Rational { mu_s, delta } => [mu_s, delta, 0.0],
-            FrictionLaw::Stribeck { .. } => [0.0; 3],
+            FrictionLaw::Stribeck { .. } | FrictionLaw::Tanh { .. } => [0.0; 3],
         });
         let col = |j: usize| Lanes::new(std::array::from_fn(|l| p[l][j]));
         match laws[0] {
@@ -59,8 +59,8 @@ impl LaneLaw {
                 mu_s: col(0),
                 delta: col(1),
             }),
-            // (exp and powf: not bit for bit lane-wise.)
-            FrictionLaw::Stribeck { .. } => None,
+            // (exp, powf and tanh: not bit for bit lane-wise.)
+            FrictionLaw::Stribeck { .. } | FrictionLaw::Tanh { .. } => None,
         }
     }
 
