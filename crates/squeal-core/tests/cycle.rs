@@ -350,3 +350,30 @@ fn coulomb_belt_return_map_is_zero() {
     assert_eq!(mu.len(), 1);
     assert!(mu[0].abs() <= 1e-6, "{mu:?}");
 }
+
+/// A mass on a belt with regularised friction (`tanh`, ε = 0.01 m/s) at
+/// V = 1 m/s: its steady sliding is stable, its one mode decays at
+/// `σ = −(c + N μ_k/ε · sech²(V/ε))/2m = −c/2m` (sech²(100) is 1e-86), and
+/// a velocity kick of 0.05 m/s never reverses the sliding, so the motion is
+/// a dying oscillation, not a limit cycle. Shooting converges on it all the
+/// same: onto steady sliding itself when the decay per period is above
+/// its tolerance (c = 2e-3: 6e-5 a period), or onto a small oscillation
+/// that loses 6e-7 a period (c = 2e-5). `find_cycle` must say that there is
+/// no cycle (with the decay rate where it has one) instead of reporting a
+/// stable limit cycle (before: one of zero amplitude with a NaN multiplier,
+/// and one whose multiplier along the flow was 0.9999994).
+#[test]
+fn a_slowly_dying_oscillation_is_no_limit_cycle() {
+    let law = FrictionLaw::Tanh {
+        mu_k: 0.3,
+        eps: 0.01,
+    };
+    let x = 100.0 * 0.3 * (100.0f64).tanh() / 1e4;
+    for (c, says) in [(2e-3, "zero amplitude"), (2e-5, "decays at σ = -1.0")] {
+        let b = belt(1.0, 1e4, 100.0, 1.0, c, law);
+        match find_cycle(&b, 0.0, [x, 0.05], &CycleOptions::default()) {
+            Err(cycle::CycleError::Vanishing(m)) => assert!(m.contains(says), "c = {c}: {m}"),
+            other => panic!("c = {c}: expected no cycle, got {other:?}"),
+        }
+    }
+}

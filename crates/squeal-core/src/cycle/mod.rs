@@ -739,6 +739,29 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
         };
         spent += settled;
         attempt += 1;
+        if c.amplitude.iter().all(|&a| a == 0.0)
+            || !c
+                .multipliers
+                .iter()
+                .all(|m| m.re.is_finite() && m.im.is_finite())
+        {
+            return Err(CycleError::Vanishing(
+                "shooting converged onto steady sliding itself (zero amplitude): the \
+                 oscillation dies out, there is no periodic orbit to follow"
+                    .into(),
+            ));
+        }
+        if let Some(sigma) = decaying(&c) {
+            return Err(CycleError::Vanishing(format!(
+                "the oscillation shooting converged on ({:.6} Hz) decays at σ = {sigma:.4e} 1/s: \
+                 its multiplier along the flow, {:.9}, is as far below 1 as its slowest \
+                 transverse one ({:.9}), so it is a slowly dying oscillation onto steady \
+                 sliding, not a periodic orbit",
+                1.0 / c.period,
+                (sigma * c.period).exp(),
+                c.max_multiplier
+            )));
+        }
         if c.stable || attempt >= 4 || c.max_multiplier <= 1.0 {
             let mut c = c;
             c.settle_time = spent;
@@ -760,6 +783,22 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
             return Ok(c);
         }
     }
+}
+
+/// The decay rate `σ = ln μ_t / T` if the orbit `c` is no periodic orbit but
+/// a slowly dying oscillation: its multiplier along the flow `μ_t` is below
+/// 1 by more than the shooting residual could explain (10×) and by at
+/// least half the gap `1 − |μ|max` of its slowest transverse multiplier.
+/// On a periodic orbit `μ_t = 1` (the flow vector is carried into itself)
+/// up to the residual, while an oscillation that decays, e.g. a weakly
+/// damped linear mode about stable steady sliding, loses amplitude along
+/// the flow as fast as across it: Newton shooting with a tolerance above
+/// its decay per period converges on it all the same.
+fn decaying<const N: usize>(c: &Cycle<N>) -> Option<f64> {
+    let t = c.multipliers.iter().find(|m| m.trivial)?;
+    let below = 1.0 - t.abs();
+    let gap = 1.0 - c.max_multiplier;
+    (below > 10.0 * c.residual && gap > 0.0 && below >= 0.5 * gap).then(|| t.abs().ln() / c.period)
 }
 
 /// One settling run from `(t0, z0)` and the shooting that follows it.
