@@ -39,6 +39,7 @@ pub mod cycle;
 pub mod dmig;
 pub mod friction;
 pub mod harwell_boeing;
+pub mod hb;
 pub mod initial;
 pub mod integrate;
 pub mod labelled;

@@ -11,6 +11,7 @@ mod cycle;
 mod engine;
 mod ensemble;
 mod equilibrium;
+mod hb;
 mod lanczos;
 mod lumped;
 mod lumped_lanes;

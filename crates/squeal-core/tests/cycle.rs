@@ -191,7 +191,8 @@ fn disc_pad_monodromy_two_ways_n2000() {
 
 /// The van der Pol oscillator `ẍ − ε(1 − x²)ẋ + x = 0`: a smooth limit cycle
 /// with no events (one mode, no guards).
-struct VanDerPol(f64);
+/// Van der Pol's oscillator `ẍ − ε(1 − x²)ẋ + x = 0` (smooth; tests/hb.rs uses it too).
+pub struct VanDerPol(pub f64);
 
 impl squeal_core::Model<2> for VanDerPol {
     fn name(&self) -> &'static str {

@@ -16,6 +16,7 @@ pub mod critical;
 pub mod cycle;
 pub mod error;
 pub mod feasible;
+pub mod hb;
 pub mod input;
 pub mod inspect;
 pub mod levers;

@@ -59,6 +59,8 @@ enum Command {
     Critical(commands::critical::CriticalArgs),
     /// The limit cycle a scenario settles on: period, Floquet multipliers, amplitudes, events.
     Cycle(commands::cycle::CycleArgs),
+    /// The self-excited periodic orbit by harmonic balance: frequency, harmonics, convergence, Floquet multipliers.
+    Hb(commands::hb::HbArgs),
     /// Follow the limit cycle in one parameter: branch.csv, bifurcations, diagram.
     Branch(commands::branch::BranchArgs),
     /// Every eigenvalue along a one-parameter sweep, modes tracked: sweep.csv and the mode-coupling diagram.
@@ -153,6 +155,7 @@ fn dispatch(command: Command) -> Result<(), RunError> {
         Command::Listen(a) => commands::listen::run(a),
         Command::Cycle(a) => commands::cycle::run(a),
         Command::Branch(a) => commands::branch::run(a),
+        Command::Hb(a) => commands::hb::run(a),
     }
 }
 

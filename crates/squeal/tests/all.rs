@@ -8,6 +8,7 @@ mod cli_common;
 mod condense_cli;
 mod cycle_cli;
 mod fe_files_cli;
+mod hb_cli;
 mod levers_cli;
 mod lumped_cli;
 mod params_cli;

@@ -258,7 +258,7 @@ fn scaled_jacobian<S: System<N> + ?Sized, const N: usize>(
 /// of the orbit. It is left out of the variational equations, and the
 /// period matrix holds zeros there (an idle perturbation that dies at
 /// once: `M − I = −I` keeps the shooting matrix regular).
-fn real_indices<S: System<N> + ?Sized, const N: usize>(sys: &S) -> Vec<usize> {
+pub(crate) fn real_indices<S: System<N> + ?Sized, const N: usize>(sys: &S) -> Vec<usize> {
     let r = sys.norm_states();
     if r >= N || r % 2 != 0 {
         (0..N).collect()
@@ -342,7 +342,7 @@ fn saltation<S: System<N> + ?Sized, const N: usize>(
 
 /// The time from which the model is autonomous (after its last breakpoint,
 /// e.g. the end of a load ramp): every period is integrated from there.
-fn autonomous_from<S: System<N> + ?Sized, const N: usize>(sys: &S) -> f64 {
+pub(crate) fn autonomous_from<S: System<N> + ?Sized, const N: usize>(sys: &S) -> f64 {
     let mut t = 0.0;
     for _ in 0..1000 {
         match sys.breakpoint_after(t) {
@@ -1085,6 +1085,66 @@ pub fn orbit<S: System<N> + ?Sized, const N: usize>(
         Some(&mut o),
     )?;
     Ok(o)
+}
+
+/// One period of length `period` from `z0`, sampled densely (every step's
+/// end and every event, before and after): the orbit of an approximate
+/// periodic solution (e.g. a harmonic-balance one, or a settling run's
+/// last return) that need not close.
+pub fn sample_period<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    z0: &[f64; N],
+    period: f64,
+    opts: &CycleOptions,
+) -> Result<Orbit<N>, CycleError> {
+    let mut o = Orbit::default();
+    period_flow(sys, z0, period, &[1.0; N], opts, false, Some(&mut o))?;
+    Ok(o)
+}
+
+/// The Floquet analysis of one period `period` from `z0` without Newton
+/// shooting: the monodromy by the variational equations and the saltation
+/// matrices along the exact (non-smooth) flow, its multipliers on the
+/// section through `z0` of the velocity whose scaled rate is largest, and
+/// as `residual` the scaled defect `|φ_T(z₀) − z₀|` (how far `(z0,
+/// period)` is from a periodic orbit of the event-driven model). Used to
+/// judge the stability of a harmonic-balance orbit with stick and
+/// reversal events treated exactly.
+pub fn floquet_from<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    z0: &[f64; N],
+    period: f64,
+    opts: &CycleOptions,
+) -> Result<Cycle<N>, CycleError> {
+    if !(period > 0.0 && period.is_finite()) {
+        return Err(CycleError::Bad(format!("period {period}")));
+    }
+    let first = period_flow(sys, z0, period, &[1.0; N], opts, false, None)?;
+    let mut amp = [0.0; N];
+    for i in 0..N {
+        amp[i] = 0.5 * (first.hi[i] - first.lo[i]);
+    }
+    let s = block_scales(&amp, &opts.solver);
+    let p = period_flow(sys, z0, period, &s, opts, true, None)?;
+    let defect = (0..N)
+        .map(|i| ((p.z_end[i] - z0[i]) / s[i]).abs())
+        .fold(0.0, f64::max);
+    let t_a = autonomous_from(sys);
+    let mut f = [0.0; N];
+    let modes = sys.start_modes(t_a, z0);
+    sys.field(t_a, &modes, z0, &mut f);
+    let idx = real_indices(sys);
+    let index = idx
+        .iter()
+        .copied()
+        .filter(|&i| i >= N / 2)
+        .max_by(|&a, &b| (f[a] / s[a]).abs().total_cmp(&(f[b] / s[b]).abs()))
+        .ok_or_else(|| CycleError::Bad("no velocity state".into()))?;
+    let section = Section {
+        index,
+        level: z0[index],
+    };
+    finish(sys, *z0, period, section, s, defect, 0, p)
 }
 
 /// The monodromy matrix by finite differences through the event-driven flow:

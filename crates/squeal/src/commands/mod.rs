@@ -3,6 +3,7 @@
 pub mod branch;
 pub mod critical;
 pub mod cycle;
+pub mod hb;
 pub mod inspect;
 pub mod listen;
 pub mod map;

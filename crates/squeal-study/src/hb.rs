@@ -1,0 +1,367 @@
+//! `squeal hb`: the self-excited periodic orbit of a scenario by harmonic
+//! balance (`squeal_core::hb`), with its convergence in the number of
+//! harmonics and its stability by one shooting period from the HB orbit.
+//!
+//! The guess is a settled simulation's last period (the settling of
+//! `squeal cycle`); HB is then solved for `H/4`, `H/2` and `H` harmonics,
+//! each from the last, and the table of frequency and amplitude changes
+//! shows whether the series has converged. The Floquet multipliers come
+//! from the variational equations and saltation matrices along the exact
+//! event-driven flow over one period from the HB orbit's state at phase
+//! 0 (`squeal_core::cycle::floquet_from`); the scaled defect of that
+//! period, `|φ_T(z₀) − z₀|`, measures how far the HB orbit is from a
+//! periodic orbit of the exact model.
+
+use crate::cycle::{events_json, real_states};
+use crate::error::{Cancel, StudyError};
+use crate::scenario::{InputError, Scenario};
+use serde_json::{json, Map, Value};
+use squeal_core::cycle::{self, CycleError, CycleOptions};
+use squeal_core::hb::{harmonic_balance, Fourier, HbError, HbOptions};
+use squeal_core::System;
+
+/// Most harmonics `squeal hb` takes: the Jacobian is dense, `(n(2H+1))²`.
+pub const MAX_HARMONICS: usize = 400;
+
+/// Largest relative change of the frequency (and, ×100, of the amplitudes)
+/// between the last two truncations that counts as converged.
+pub const CONVERGED_FREQ: f64 = 1e-5;
+
+/// One row of the convergence table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Truncation {
+    /// Harmonics kept.
+    pub harmonics: usize,
+    /// Frequency (Hz).
+    pub freq_hz: f64,
+    /// Largest relative change of a state's amplitude from the previous row
+    /// (states above 1e-6 of the largest of their kind; NaN for the first row).
+    pub amplitude_change: f64,
+    /// Final scaled residual.
+    pub residual: f64,
+    /// Newton iterations.
+    pub iterations: usize,
+}
+
+/// A harmonic-balance orbit, independent of the state count.
+#[derive(Debug, Clone)]
+pub struct HbFound {
+    /// Real state names (positions, then velocities).
+    pub names: Vec<String>,
+    /// Harmonics of the final solution.
+    pub harmonics: usize,
+    /// Period (s).
+    pub period: f64,
+    /// Half peak-to-peak of each state over one period (from the series).
+    pub amplitude: Vec<f64>,
+    /// Per dof (position state): the mean and the amplitude `√(a_k² + b_k²)` of harmonics 1…H (m).
+    pub spectrum: Vec<Vec<f64>>,
+    /// Per contact: name and the fraction of the period in slip+, slip−, stick, no contact.
+    pub fractions: Vec<(String, [f64; 4])>,
+    /// Mode switches per period.
+    pub switches: usize,
+    /// Panels per period of the frequency–time step.
+    pub panels: usize,
+    /// Floquet multipliers `(re, im, trivial)` of one exact period from the HB orbit.
+    pub multipliers: Vec<(f64, f64, bool)>,
+    /// Whether every non-trivial multiplier is inside the unit circle.
+    pub stable: bool,
+    /// Largest non-trivial modulus.
+    pub max_multiplier: f64,
+    /// Scaled `|φ_T(z₀) − z₀|` of the exact flow from the HB orbit.
+    pub defect: f64,
+    /// Events of the exact flow over that period (order of `EventKind::ALL`).
+    pub events: [u64; 5],
+    /// The convergence table, coarsest first.
+    pub convergence: Vec<Truncation>,
+    /// Final scaled HB residual and Newton iterations.
+    pub residual: f64,
+    /// Newton iterations of the final solution.
+    pub iterations: usize,
+    /// Simulated settling time of the guess (s).
+    pub settle_time: f64,
+    /// What the numbers do not support, if anything.
+    pub warnings: Vec<String>,
+}
+
+/// Check `--harmonics`.
+pub fn check_harmonics(h: usize) -> Result<(), InputError> {
+    if h == 0 || h > MAX_HARMONICS {
+        return Err(InputError(format!(
+            "--harmonics {h}: must be in 1..={MAX_HARMONICS} (the Newton matrix is dense, (dofs·(2H+1))² entries)"
+        )));
+    }
+    Ok(())
+}
+
+fn cycle_err(e: CycleError) -> StudyError {
+    match e {
+        CycleError::Bad(m) => StudyError::Input(InputError(m)),
+        other => StudyError::Numerical(format!("hb: settling for a guess: {other}")),
+    }
+}
+
+fn hb_err(e: HbError) -> StudyError {
+    match e {
+        HbError::Bad(m) => StudyError::Input(InputError(format!("hb: {m}"))),
+        other => StudyError::Numerical(format!("hb: {other}")),
+    }
+}
+
+/// Half peak-to-peak of every state of the series (`N` states), from
+/// `16(2H+1)` samples (at least 4096).
+fn amplitudes<const N: usize>(f: &Fourier) -> [f64; N] {
+    let m = (16 * (2 * f.harmonics() + 1)).max(4096);
+    let mut lo = [f64::INFINITY; N];
+    let mut hi = [f64::NEG_INFINITY; N];
+    for j in 0..m {
+        let z: [f64; N] = f.state(std::f64::consts::TAU * j as f64 / m as f64);
+        for i in 0..N {
+            lo[i] = lo[i].min(z[i]);
+            hi[i] = hi[i].max(z[i]);
+        }
+    }
+    let mut a = [0.0; N];
+    for i in 0..N {
+        a[i] = 0.5 * (hi[i] - lo[i]);
+    }
+    a
+}
+
+/// Largest relative change between two amplitude lists, over the states
+/// above 1e-6 of the largest of their block (positions, velocities).
+fn amplitude_change(real: &[usize], a: &[f64], b: &[f64]) -> f64 {
+    let half = real.len() / 2;
+    let mut out: f64 = 0.0;
+    for blk in [&real[..half], &real[half..]] {
+        let top = blk.iter().map(|&i| b[i]).fold(0.0, f64::max);
+        for &i in blk {
+            if b[i] > 1e-6 * top {
+                out = out.max((a[i] / b[i] - 1.0).abs());
+            }
+        }
+    }
+    out
+}
+
+fn solve<M: System<N> + ?Sized, const N: usize>(
+    m: &M,
+    any: &crate::AnyModel,
+    z0: &[f64],
+    harmonics: usize,
+    opts: &CycleOptions,
+    cancel: &Cancel,
+) -> Result<HbFound, StudyError> {
+    let mut start = [0.0; N];
+    start.copy_from_slice(z0);
+    let (_, z, period, settled) = cycle::settle(m, 0.0, start, opts).map_err(cycle_err)?;
+    cancel.check()?;
+    let orbit = cycle::sample_period(m, &z, period, opts).map_err(cycle_err)?;
+    let real = real_states::<N>(m.norm_states());
+    let n = real.len() / 2;
+    if let Some(k) = orbit.modes.iter().find_map(|md| {
+        md.as_slice()
+            .iter()
+            .position(|&x| x == squeal_core::Mode::Stick)
+    }) {
+        return Err(StudyError::Input(InputError(format!(
+            "hb: the orbit the scenario settles on sticks (contact {}): harmonic balance here treats friction as slip and contact loss exactly, but a sticking contact's force is a constraint force (a dynamic Lagrangian scheme, not built); use squeal cycle",
+            m.contact_name(k)
+        ))));
+    }
+    // Fitted with enough harmonics to see whether the settled "period" is
+    // several turns of the orbit; then at its minimal period (the turns of
+    // a settling run agree to its tolerance only: 1e-4 of the energy).
+    let simulated = Fourier::from_orbit(&orbit, period, n, 4 * harmonics.max(8))
+        .minimal(1e-4)
+        .resized(harmonics);
+    let mut guess = simulated.clone();
+    let mut ladder = vec![(harmonics / 4).max(1), (harmonics / 2).max(1), harmonics];
+    ladder.dedup();
+    let mut convergence = Vec::new();
+    let mut last = None;
+    let mut prev_amp: Option<[f64; N]> = None;
+    for &h in &ladder {
+        // From the last truncation's solution, else from the simulation
+        // (a coarse truncation can converge onto a smoothed orbit far from
+        // the finer one).
+        let hb_opts = HbOptions {
+            harmonics: h,
+            ..HbOptions::default()
+        };
+        let o = match harmonic_balance(m, &guess, &hb_opts) {
+            Ok(o) => o,
+            Err(HbError::NotConverged(_)) if guess != simulated => {
+                harmonic_balance(m, &simulated, &hb_opts).map_err(hb_err)?
+            }
+            Err(e) => return Err(hb_err(e)),
+        };
+        cancel.check()?;
+        let amp = amplitudes::<N>(&o.fourier);
+        convergence.push(Truncation {
+            harmonics: h,
+            freq_hz: 1.0 / o.period(),
+            amplitude_change: prev_amp.map_or(f64::NAN, |p| amplitude_change(&real, &amp, &p)),
+            residual: o.residual,
+            iterations: o.iterations,
+        });
+        prev_amp = Some(amp);
+        guess = o.fourier.clone();
+        last = Some(o);
+    }
+    let o = last.expect("at least one truncation");
+    let amp = prev_amp.expect("at least one truncation");
+    let z_hb: [f64; N] = o.fourier.state(0.0);
+    let c = cycle::floquet_from(m, &z_hb, o.period(), opts).map_err(cycle_err)?;
+    let names = any.state_names();
+    let contacts: Vec<(String, [f64; 4])> = o
+        .fractions
+        .iter()
+        .enumerate()
+        .map(|(i, f)| (m.contact_name(i).to_string(), *f))
+        .collect();
+    let mut warnings = Vec::new();
+    if convergence.len() >= 2 {
+        let (a, b) = (
+            &convergence[convergence.len() - 2],
+            &convergence[convergence.len() - 1],
+        );
+        let df = (b.freq_hz / a.freq_hz - 1.0).abs();
+        if df > CONVERGED_FREQ || b.amplitude_change > 100.0 * CONVERGED_FREQ {
+            warnings.push(format!(
+                "not converged in the harmonics: from H = {} to {} the frequency changed by {df:.1e} and an amplitude by {:.1e} (relative); raise --harmonics",
+                a.harmonics, b.harmonics, b.amplitude_change
+            ));
+        }
+    }
+    if o.sticks {
+        warnings.push(
+            "a contact sticks on the orbit: harmonic balance treats stick as slip at zero speed, not as a constraint; use squeal cycle".into(),
+        );
+    }
+    if c.residual > 1e-2 {
+        warnings.push(format!(
+            "one period of the exact model from the HB orbit misses its start by {:.2e} (scaled): the series is not yet the orbit (truncation, or stick), and the multipliers are those of a nearby trajectory; compare with squeal cycle",
+            c.residual
+        ));
+    }
+    Ok(HbFound {
+        harmonics,
+        period: o.period(),
+        amplitude: real.iter().map(|&i| amp[i]).collect(),
+        spectrum: o
+            .fourier
+            .coeffs
+            .iter()
+            .enumerate()
+            .map(|(i, co)| {
+                std::iter::once(co[0])
+                    .chain((1..=o.fourier.harmonics()).map(|k| o.fourier.amplitude(i, k)))
+                    .collect()
+            })
+            .collect(),
+        fractions: contacts,
+        switches: o.switches,
+        panels: o.panels,
+        multipliers: c
+            .multipliers
+            .iter()
+            .map(|m| (m.re, m.im, m.trivial))
+            .collect(),
+        stable: c.stable,
+        max_multiplier: c.max_multiplier,
+        defect: c.residual,
+        events: c.events_per_period,
+        convergence,
+        residual: o.residual,
+        iterations: o.iterations,
+        settle_time: settled,
+        warnings,
+        names,
+    })
+}
+
+/// The harmonic-balance orbit of a scenario with `harmonics` harmonics,
+/// its guess settled from the scenario's initial state with `opts` (those
+/// of `squeal cycle`, [`crate::cycle::checked_options`]).
+pub fn of_scenario(
+    sc: &Scenario,
+    harmonics: usize,
+    opts: &CycleOptions,
+    cancel: &Cancel,
+) -> Result<HbFound, StudyError> {
+    check_harmonics(harmonics)?;
+    cancel.check()?;
+    crate::with_sim_system!(&sc.model, m => {
+        let z0 = crate::run::initial_of(m, sc)?;
+        solve(m, &sc.model, &z0, harmonics, opts, cancel)
+    }, else => Err(StudyError::Input(InputError(sc.model.check_cycle_size().err().unwrap_or_default()))))
+}
+
+impl HbFound {
+    /// The JSON document: `squeal cycle`'s keys where they mean the same
+    /// (`period`, `frequency_hz`, `amplitude`, `stable`, `multipliers`,
+    /// `max_multiplier`, `events_per_period`) plus `freq_hz`, `harmonics`
+    /// (per dof: mean, then the amplitude of each harmonic, m),
+    /// `harmonic_count`, `contact_modes`, `convergence`, `shooting_defect`
+    /// and `warnings`.
+    pub fn to_json(&self) -> Value {
+        let multipliers: Vec<Value> = self
+            .multipliers
+            .iter()
+            .map(|&(re, im, trivial)| {
+                json!({ "re": re, "im": im, "abs": re.hypot(im), "trivial": trivial })
+            })
+            .collect();
+        let mut amplitude = Map::new();
+        for (n, a) in self.names.iter().zip(&self.amplitude) {
+            amplitude.insert(n.clone(), json!(a));
+        }
+        let mut harmonics = Map::new();
+        for (n, s) in self.names.iter().zip(&self.spectrum) {
+            harmonics.insert(n.clone(), json!(s));
+        }
+        let mut modes = Map::new();
+        for (name, f) in &self.fractions {
+            modes.insert(
+                name.clone(),
+                json!({ "slip_pos": f[0], "slip_neg": f[1], "stick": f[2], "free": f[3] }),
+            );
+        }
+        let convergence: Vec<Value> = self
+            .convergence
+            .iter()
+            .map(|t| {
+                json!({
+                    "harmonics": t.harmonics,
+                    "freq_hz": t.freq_hz,
+                    "amplitude_change": if t.amplitude_change.is_finite() { json!(t.amplitude_change) } else { Value::Null },
+                    "residual": t.residual,
+                    "newton_iterations": t.iterations,
+                })
+            })
+            .collect();
+        json!({
+            "method": "harmonic balance",
+            "period": self.period,
+            "freq_hz": 1.0 / self.period,
+            "frequency_hz": 1.0 / self.period,
+            "harmonic_count": self.harmonics,
+            "harmonics": harmonics,
+            "amplitude": amplitude,
+            "stable": self.stable,
+            "multipliers": multipliers,
+            "max_multiplier": self.max_multiplier,
+            "events_per_period": events_json(&self.events),
+            "shooting_defect": self.defect,
+            "contact_modes": modes,
+            "switches_per_period": self.switches,
+            "panels": self.panels,
+            "convergence": convergence,
+            "residual": self.residual,
+            "newton_iterations": self.iterations,
+            "settle_time": self.settle_time,
+            "warnings": self.warnings,
+        })
+    }
+}

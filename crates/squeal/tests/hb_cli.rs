@@ -1,0 +1,97 @@
+//! `squeal hb` end to end: the JSON against `squeal cycle`'s on the same
+//! scenario (frequency, amplitudes, multipliers), and what it refuses.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn squeal(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_squeal"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("squeal runs")
+}
+
+fn json_of(out: &Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// Hoffmann's two-dof model with contact loss (no stick, no reversal):
+/// HB at H = 20 against shooting.
+#[test]
+fn hoffmann_hb_equals_the_shooting_cycle() {
+    let d = tempfile::tempdir().unwrap();
+    let hb = json_of(&squeal(d.path(), &["hb", "hoffmann", "--json"]));
+    let cy = json_of(&squeal(d.path(), &["cycle", "hoffmann", "--json"]));
+    let (fh, fc) = (
+        hb["freq_hz"].as_f64().unwrap(),
+        cy["frequency_hz"].as_f64().unwrap(),
+    );
+    // Measured: 6e-11.
+    assert!((fh / fc - 1.0).abs() <= 1e-8, "{fh} vs {fc}");
+    assert_eq!(hb["frequency_hz"], hb["freq_hz"]);
+    assert!((hb["period"].as_f64().unwrap() * fh - 1.0).abs() < 1e-14);
+    // Amplitudes (half peak-to-peak of the series, and of shooting's
+    // step ends: the latter can only be smaller, by the step's sampling).
+    for s in ["x", "y", "vx", "vy"] {
+        let (a, b) = (
+            hb["amplitude"][s].as_f64().unwrap(),
+            cy["amplitude"][s].as_f64().unwrap(),
+        );
+        assert!((a / b - 1.0).abs() <= 2e-3, "{s}: {a} vs {b}");
+    }
+    // The multipliers: the same exact period, from the HB state.
+    let (mh, mc) = (
+        hb["multipliers"].as_array().unwrap(),
+        cy["multipliers"].as_array().unwrap(),
+    );
+    assert_eq!(mh.len(), mc.len());
+    for (a, b) in mh.iter().zip(mc) {
+        let (a, b) = (a["abs"].as_f64().unwrap(), b["abs"].as_f64().unwrap());
+        assert!((a - b).abs() <= 1e-6, "{a} vs {b}");
+    }
+    assert_eq!(hb["stable"], cy["stable"]);
+    // The convergence table: H/4, H/2, H; the harmonics per dof: mean and 20.
+    let conv = hb["convergence"].as_array().unwrap();
+    let hs: Vec<u64> = conv
+        .iter()
+        .map(|r| r["harmonics"].as_u64().unwrap())
+        .collect();
+    assert_eq!(hs, [5, 10, 20]);
+    assert!(conv[0]["amplitude_change"].is_null());
+    assert_eq!(hb["harmonics"]["x"].as_array().unwrap().len(), 21);
+    // Contact loss, about 31 % of the period; no stick.
+    let m = &hb["contact_modes"]["belt"];
+    let free = m["free"].as_f64().unwrap();
+    assert!(free > 0.2 && free < 0.4, "{m}");
+    assert_eq!(m["stick"].as_f64().unwrap(), 0.0);
+    assert!(hb["shooting_defect"].as_f64().unwrap() < 1e-5);
+    assert!(hb["warnings"].as_array().unwrap().is_empty(), "{hb}");
+}
+
+#[test]
+fn hb_refuses_what_it_cannot_do_in_one_line() {
+    let d = tempfile::tempdir().unwrap();
+    // The thesis law's belt settles on stick-slip.
+    let out = squeal(d.path(), &["hb", "belt"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("sticks") && err.contains("squeal cycle"),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(out.stdout.is_empty());
+    for h in ["0", "401"] {
+        let out = squeal(d.path(), &["hb", "hoffmann", "--harmonics", h]);
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(&format!("--harmonics {h}")), "{err}");
+    }
+    assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 0);
+}
