@@ -40,6 +40,7 @@ __all__ = [
     "branch",
     "critical",
     "cycle",
+    "hb",
     "inspect",
     "listen",
     "map",
@@ -605,6 +606,41 @@ def cycle(
         doc["orbit"] = raw["orbit"]
         doc["orbit_events"] = list(raw["orbit_events"])
     return doc
+
+
+def hb(
+    scenario: Scenario = "disc-pad",
+    *,
+    harmonics: int = 20,
+    settle_steps: int = 20_000_000,
+    settle_time: float = 1000.0,
+    settle_tol: float = 1e-2,
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
+) -> Dict[str, Any]:
+    """The self-excited periodic orbit by harmonic balance (``squeal hb
+    --json``): ``freq_hz`` (Hz) and ``period`` (s); ``amplitude`` per state
+    (half peak-to-peak, m or m/s); ``harmonics`` per dof (the mean, then
+    the amplitude of harmonics 1…H, m); ``contact_modes`` (fraction of the
+    period each contact spends in slip+, slip−, stick, free);
+    ``multipliers`` as ``{re, im, abs, trivial}`` and ``stable`` from one
+    exact period from the HB orbit, whose scaled miss is
+    ``shooting_defect``; ``convergence`` (rows for H/4, H/2, H:
+    ``harmonics``, ``freq_hz``, ``amplitude_change``, ``residual``);
+    ``warnings``. ``harmonics`` is H (1…400); the settling options are
+    ``cycle``'s. Orbits that stick raise ``ScenarioError``."""
+    return dict(
+        json.loads(
+            _squeal.hb(
+                *_source(scenario),
+                _sets(set, params),
+                int(harmonics),
+                int(settle_steps),
+                float(settle_time),
+                float(settle_tol),
+            )
+        )
+    )
 
 
 def branch(

@@ -681,6 +681,34 @@ fn cycle<'py>(
     Ok(out)
 }
 
+/// The periodic orbit by harmonic balance (`squeal hb --json`): the
+/// document as JSON text.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn hb(
+    py: Python<'_>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    harmonics: usize,
+    settle_steps: u64,
+    settle_time: f64,
+    settle_tol: f64,
+) -> PyResult<String> {
+    let sc = resolve(kind, text, &sets)?;
+    squeal_study::hb::check_harmonics(harmonics)
+        .map_err(|e| study_err(squeal_study::StudyError::Input(e)))?;
+    let opts =
+        squeal_study::cycle::checked_options(&sc, settle_steps, settle_time, settle_tol, None)
+            .map_err(study_err)?;
+    let found = compute(py, |cancel| {
+        squeal_study::hb::of_scenario(&sc, harmonics, &opts, false, cancel)
+    })?;
+    let mut doc = found.to_json();
+    doc["scenario"] = sc.to_json();
+    json_text(&doc)
+}
+
 /// A branch of limit cycles (`squeal branch --json`): the document as JSON
 /// text.
 #[pyfunction]
@@ -729,6 +757,7 @@ fn _squeal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(critical, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(cycle, m)?)?;
+    m.add_function(wrap_pyfunction!(hb, m)?)?;
     m.add_function(wrap_pyfunction!(branch, m)?)?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add_function(wrap_pyfunction!(inspect, m)?)?;

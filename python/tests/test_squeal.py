@@ -342,6 +342,20 @@ def test_cycle_and_branch_bad_input_names_the_flag():
         squeal.branch("disc-pad", param=("bogus", 0.5, 0.6, 3))
 
 
+def test_hb_equals_cli_json_and_the_shooting_cycle(cli):
+    doc = json.loads(cli("hb", "hoffmann", "--harmonics", "12", "--json"))
+    h = squeal.hb("hoffmann", harmonics=12)
+    assert h == doc
+    c = squeal.cycle("hoffmann")
+    assert h["freq_hz"] == pytest.approx(c["frequency_hz"], rel=1e-8)
+    assert [r["harmonics"] for r in h["convergence"]] == [3, 6, 12]
+    assert len(h["harmonics"]["x"]) == 13
+    with pytest.raises(squeal.ScenarioError, match="harmonics 0"):
+        squeal.hb("hoffmann", harmonics=0)
+    with pytest.raises(squeal.ScenarioError, match="sticks"):
+        squeal.hb("belt")
+
+
 def test_reproduce_equals_the_clis_table_and_conclusions(cli, tmp_path):
     cli("reproduce", "--duration-scale", "0.5", "--no-figures", "--out", str(tmp_path / "r"))
     r = squeal.reproduce(duration_scale=0.5)

@@ -43,6 +43,9 @@ pub struct Truncation {
     pub iterations: usize,
 }
 
+/// Table rows `[t, states…]`.
+pub type Rows = Vec<Vec<f64>>;
+
 /// A harmonic-balance orbit, independent of the state count.
 #[derive(Debug, Clone)]
 pub struct HbFound {
@@ -82,6 +85,10 @@ pub struct HbFound {
     pub settle_time: f64,
     /// What the numbers do not support, if anything.
     pub warnings: Vec<String>,
+    /// One period, if asked for: the series sampled at `16(2H+1)` phases
+    /// (at least 1024), and the exact flow from its state at phase 0
+    /// (step ends and events); rows `[t, states…]`.
+    pub orbit: Option<(Rows, Rows)>,
 }
 
 /// Check `--harmonics`.
@@ -150,6 +157,7 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
     z0: &[f64],
     harmonics: usize,
     opts: &CycleOptions,
+    with_orbit: bool,
     cancel: &Cancel,
 ) -> Result<HbFound, StudyError> {
     let mut start = [0.0; N];
@@ -214,6 +222,33 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
     let z_hb: [f64; N] = o.fourier.state(0.0);
     let c = cycle::floquet_from(m, &z_hb, o.period(), opts).map_err(cycle_err)?;
     let names = any.state_names();
+    let orbit = if with_orbit {
+        let period = o.period();
+        let m_rows = (16 * (2 * harmonics + 1)).max(1024);
+        let series = (0..=m_rows)
+            .map(|j| {
+                let th = std::f64::consts::TAU * j as f64 / m_rows as f64;
+                let z: [f64; N] = o.fourier.state(th);
+                std::iter::once(period * j as f64 / m_rows as f64)
+                    .chain(real.iter().map(|&i| z[i]))
+                    .collect()
+            })
+            .collect();
+        let flow = cycle::sample_period(m, &z_hb, period, opts).map_err(cycle_err)?;
+        let exact = flow
+            .t
+            .iter()
+            .zip(&flow.z)
+            .map(|(t, z)| {
+                std::iter::once(*t)
+                    .chain(real.iter().map(|&i| z[i]))
+                    .collect()
+            })
+            .collect();
+        Some((series, exact))
+    } else {
+        None
+    };
     let contacts: Vec<(String, [f64; 4])> = o
         .fractions
         .iter()
@@ -277,24 +312,27 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
         iterations: o.iterations,
         settle_time: settled,
         warnings,
+        orbit,
         names,
     })
 }
 
 /// The harmonic-balance orbit of a scenario with `harmonics` harmonics,
 /// its guess settled from the scenario's initial state with `opts` (those
-/// of `squeal cycle`, [`crate::cycle::checked_options`]).
+/// of `squeal cycle`, [`crate::cycle::checked_options`]); `with_orbit`:
+/// also one period of the series and of the exact flow from it.
 pub fn of_scenario(
     sc: &Scenario,
     harmonics: usize,
     opts: &CycleOptions,
+    with_orbit: bool,
     cancel: &Cancel,
 ) -> Result<HbFound, StudyError> {
     check_harmonics(harmonics)?;
     cancel.check()?;
     crate::with_sim_system!(&sc.model, m => {
         let z0 = crate::run::initial_of(m, sc)?;
-        solve(m, &sc.model, &z0, harmonics, opts, cancel)
+        solve(m, &sc.model, &z0, harmonics, opts, with_orbit, cancel)
     }, else => Err(StudyError::Input(InputError(sc.model.check_cycle_size().err().unwrap_or_default()))))
 }
 

@@ -26,7 +26,32 @@ fn json_of(out: &Output) -> serde_json::Value {
 #[test]
 fn hoffmann_hb_equals_the_shooting_cycle() {
     let d = tempfile::tempdir().unwrap();
-    let hb = json_of(&squeal(d.path(), &["hb", "hoffmann", "--json"]));
+    let hb = json_of(&squeal(
+        d.path(),
+        &["hb", "hoffmann", "--json", "--out", "h"],
+    ));
+    // The files: the document as printed, one period of the series (its
+    // last row the first again), the picture.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("h/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary, hb);
+    let csv = std::fs::read_to_string(d.path().join("h/hb_orbit.csv")).unwrap();
+    assert_eq!(csv.lines().next().unwrap(), "t,x,y,vx,vy");
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+        .collect();
+    let (first, last) = (&rows[0], &rows[rows.len() - 1]);
+    assert!((last[0] - hb["period"].as_f64().unwrap()).abs() < 1e-15);
+    for c in 1..5 {
+        assert!(
+            (last[c] - first[c]).abs() <= 1e-12 * first[c].abs().max(1.0),
+            "{c}"
+        );
+    }
+    assert!(d.path().join("h/hb.png").is_file());
     let cy = json_of(&squeal(d.path(), &["cycle", "hoffmann", "--json"]));
     let (fh, fc) = (
         hb["freq_hz"].as_f64().unwrap(),
