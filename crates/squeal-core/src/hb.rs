@@ -101,6 +101,10 @@ pub enum HbError {
     /// Newton's method did not converge.
     #[error("harmonic balance did not converge: {0}")]
     NotConverged(String),
+    /// Newton's method converged onto the steady state (every harmonic
+    /// zero solves the equations of an autonomous system for any ω).
+    #[error("harmonic balance converged onto steady sliding itself (amplitude {0:.3e} of the guess's): no periodic orbit near the guess")]
+    Collapsed(f64),
 }
 
 /// A truncated Fourier series of the real dofs' positions at frequency `ω`.
@@ -310,7 +314,16 @@ pub struct HbOrbit {
     pub sticks: bool,
     /// Panels per period used.
     pub panels: usize,
+    /// False if Newton's method stalled above the tolerance but within
+    /// [`STALLED`] times it (the orbit is then approximate to `residual`).
+    pub converged: bool,
 }
+
+/// Newton's method that can lower the residual no further, or runs out of
+/// iterations, within this many times the tolerance returns the orbit
+/// marked not converged (an orbit that grazes a switch, say, where two
+/// switching phases merge and the residual is not smooth); above it, an error.
+pub const STALLED: f64 = 1e4;
 
 impl HbOrbit {
     /// Period `2π/ω` (s).
@@ -584,6 +597,7 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
     bal.residual(&x, &mut r);
     let mut iterations = 0;
     let mut stalled = false;
+    let mut approximate = false;
     let mut last = f64::INFINITY;
     loop {
         let res = max_abs(&r);
@@ -592,13 +606,14 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
                 "the residual is not finite after {iterations} iterations"
             )));
         }
-        if std::env::var_os("SQUEAL_HB_TRACE").is_some() {
-            eprintln!("hb H = {h}: iteration {iterations}, residual {res:.3e}");
-        }
         if res <= opts.newton_tol || stalled || (res <= 1e2 * opts.newton_tol && res > 0.5 * last) {
             break;
         }
         if iterations >= opts.newton_iterations {
+            if res <= STALLED * opts.newton_tol {
+                approximate = true;
+                break;
+            }
             return Err(HbError::NotConverged(format!(
                 "residual {res:.3e} after {iterations} Newton iterations (H = {h})"
             )));
@@ -651,6 +666,11 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
                     stalled = true;
                     break;
                 }
+                if max_abs(&r) <= STALLED * opts.newton_tol {
+                    stalled = true;
+                    approximate = true;
+                    break;
+                }
                 return Err(HbError::NotConverged(format!(
                     "no Newton step lowers the residual {:.3e} (iteration {iterations}, H = {h})",
                     max_abs(&r)
@@ -659,6 +679,12 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
         }
     }
     let fourier = bal.to_fourier(&x);
+    let left = (0..n)
+        .map(|i| (1..=h).map(|k| fourier.amplitude(i, k)).fold(0.0, f64::max))
+        .fold(0.0, f64::max);
+    if left < 1e-6 * top {
+        return Err(HbError::Collapsed(left / top));
+    }
     let pieces = bal.pieces(&fourier);
     let contacts = sys.contacts();
     let mut fractions = vec![[0.0; 4]; contacts];
@@ -683,5 +709,6 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
         switches,
         sticks,
         panels: bal.panels,
+        converged: !approximate,
     })
 }

@@ -17,7 +17,7 @@ use crate::error::{Cancel, StudyError};
 use crate::scenario::{InputError, Scenario};
 use serde_json::{json, Map, Value};
 use squeal_core::cycle::{self, CycleError, CycleOptions};
-use squeal_core::hb::{harmonic_balance, Fourier, HbError, HbOptions};
+use squeal_core::hb::{harmonic_balance, Fourier, HbError, HbOptions, HbOrbit};
 use squeal_core::System;
 
 /// Most harmonics `squeal hb` takes: the Jacobian is dense, `(n(2H+1))²`.
@@ -151,6 +151,64 @@ fn amplitude_change(real: &[usize], a: &[f64], b: &[f64]) -> f64 {
     out
 }
 
+/// HB at `H/4`, `H/2` and `H` from `simulated` (each rung from the last
+/// solution, else from `simulated`; a coarse rung that fails is left out of
+/// the table, with a note): the final orbit, the table, the amplitudes.
+#[allow(clippy::type_complexity)]
+fn ladder<M: System<N> + ?Sized, const N: usize>(
+    m: &M,
+    simulated: &Fourier,
+    harmonics: usize,
+    real: &[usize],
+    cancel: &Cancel,
+) -> Result<(HbOrbit, Vec<Truncation>, [f64; N], Vec<String>), StudyError> {
+    let mut rungs = vec![(harmonics / 4).max(1), (harmonics / 2).max(1), harmonics];
+    rungs.dedup();
+    let mut guess = simulated.clone();
+    let mut convergence = Vec::new();
+    let mut notes = Vec::new();
+    let mut last: Option<(HbOrbit, [f64; N])> = None;
+    for &h in &rungs {
+        let hb_opts = HbOptions {
+            harmonics: h,
+            ..HbOptions::default()
+        };
+        // From the last truncation's solution, else from the simulation
+        // (a coarse truncation can converge onto a smoothed orbit far from
+        // the finer one, or onto the steady state).
+        let tried = match harmonic_balance(m, &guess, &hb_opts) {
+            Err(HbError::Bad(e)) => return Err(hb_err(HbError::Bad(e))),
+            Err(_) if guess != *simulated => harmonic_balance(m, simulated, &hb_opts),
+            other => other,
+        };
+        cancel.check()?;
+        let o = match tried {
+            Ok(o) => o,
+            Err(e) if h < harmonics => {
+                notes.push(format!(
+                    "H = {h} gave no orbit ({e}); left out of the table"
+                ));
+                continue;
+            }
+            Err(e) => return Err(hb_err(e)),
+        };
+        let amp = amplitudes::<N>(&o.fourier);
+        convergence.push(Truncation {
+            harmonics: h,
+            freq_hz: 1.0 / o.period(),
+            amplitude_change: last
+                .as_ref()
+                .map_or(f64::NAN, |(_, p)| amplitude_change(real, &amp, p)),
+            residual: o.residual,
+            iterations: o.iterations,
+        });
+        guess = o.fourier.clone();
+        last = Some((o, amp));
+    }
+    let (o, amp) = last.expect("the last rung succeeded or returned");
+    Ok((o, convergence, amp, notes))
+}
+
 fn solve<M: System<N> + ?Sized, const N: usize>(
     m: &M,
     any: &crate::AnyModel,
@@ -162,65 +220,82 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
 ) -> Result<HbFound, StudyError> {
     let mut start = [0.0; N];
     start.copy_from_slice(z0);
-    let (_, z, period, settled) = cycle::settle(m, 0.0, start, opts).map_err(cycle_err)?;
-    cancel.check()?;
-    let orbit = cycle::sample_period(m, &z, period, opts).map_err(cycle_err)?;
     let real = real_states::<N>(m.norm_states());
     let n = real.len() / 2;
-    if let Some(k) = orbit.modes.iter().find_map(|md| {
-        md.as_slice()
-            .iter()
-            .position(|&x| x == squeal_core::Mode::Stick)
-    }) {
-        return Err(StudyError::Input(InputError(format!(
-            "hb: the orbit the scenario settles on sticks (contact {}): harmonic balance here treats friction as slip and contact loss exactly, but a sticking contact's force is a constraint force (a dynamic Lagrangian scheme, not built); use squeal cycle",
-            m.contact_name(k)
-        ))));
-    }
-    // Fitted with enough harmonics to see whether the settled "period" is
-    // several turns of the orbit; then at its minimal period (the turns of
-    // a settling run agree to its tolerance only: 1e-4 of the energy).
-    let simulated = Fourier::from_orbit(&orbit, period, n, 4 * harmonics.max(8))
-        .minimal(1e-4)
-        .resized(harmonics);
-    let mut guess = simulated.clone();
-    let mut ladder = vec![(harmonics / 4).max(1), (harmonics / 2).max(1), harmonics];
-    ladder.dedup();
-    let mut convergence = Vec::new();
-    let mut last = None;
-    let mut prev_amp: Option<[f64; N]> = None;
-    for &h in &ladder {
-        // From the last truncation's solution, else from the simulation
-        // (a coarse truncation can converge onto a smoothed orbit far from
-        // the finer one).
-        let hb_opts = HbOptions {
-            harmonics: h,
-            ..HbOptions::default()
-        };
-        let o = match harmonic_balance(m, &guess, &hb_opts) {
-            Ok(o) => o,
-            Err(HbError::NotConverged(_)) if guess != simulated => {
-                harmonic_balance(m, &simulated, &hb_opts).map_err(hb_err)?
-            }
-            Err(e) => return Err(hb_err(e)),
-        };
+    // What the motion settles on is stable: as `squeal cycle` does, an
+    // unstable orbit met on the way is left by simulating on until its
+    // instability has grown a thousandfold, then settling again (at most
+    // four times).
+    let (mut t, mut z) = (0.0, start);
+    let mut spent = 0.0;
+    let mut attempt = 0;
+    let (o, convergence, amp, mut notes, c, z_hb) = loop {
+        attempt += 1;
+        let (_, zs, period, settled) = cycle::settle(m, t, z, opts).map_err(cycle_err)?;
+        spent += settled;
         cancel.check()?;
-        let amp = amplitudes::<N>(&o.fourier);
-        convergence.push(Truncation {
-            harmonics: h,
-            freq_hz: 1.0 / o.period(),
-            amplitude_change: prev_amp.map_or(f64::NAN, |p| amplitude_change(&real, &amp, &p)),
-            residual: o.residual,
-            iterations: o.iterations,
-        });
-        prev_amp = Some(amp);
-        guess = o.fourier.clone();
-        last = Some(o);
-    }
-    let o = last.expect("at least one truncation");
-    let amp = prev_amp.expect("at least one truncation");
-    let z_hb: [f64; N] = o.fourier.state(0.0);
-    let c = cycle::floquet_from(m, &z_hb, o.period(), opts).map_err(cycle_err)?;
+        let orbit = cycle::sample_period(m, &zs, period, opts).map_err(cycle_err)?;
+        if let Some(k) = orbit.modes.iter().find_map(|md| {
+            md.as_slice()
+                .iter()
+                .position(|&x| x == squeal_core::Mode::Stick)
+        }) {
+            return Err(StudyError::Input(InputError(format!(
+                "hb: the orbit the scenario settles on sticks (contact {}): harmonic balance here treats friction as slip and contact loss exactly, but a sticking contact's force is a constraint force (a dynamic Lagrangian scheme, not built); use squeal cycle",
+                m.contact_name(k)
+            ))));
+        }
+        // Fitted with enough harmonics to see whether the settled "period"
+        // is several turns of the orbit (the turns of a settling run agree
+        // to its tolerance only: up to 1e-2 of the energy may leak into
+        // the other harmonics); tried at the minimal period first, then,
+        // if that orbit is not the stable one, at the settled period (a
+        // genuine period-k orbit, near a period doubling say).
+        let full = Fourier::from_orbit(&orbit, period, n, 4 * harmonics.max(8));
+        let reduced = full.minimal(1e-2);
+        let mut guesses = vec![reduced.resized(harmonics)];
+        if reduced.omega != full.omega {
+            guesses.push(full.resized(harmonics));
+        }
+        let mut best = None;
+        let mut failure = None;
+        for g in &guesses {
+            match ladder(m, g, harmonics, &real, cancel) {
+                Ok((o, conv, amp, notes)) => {
+                    let z_hb: [f64; N] = o.fourier.state(0.0);
+                    let c = cycle::floquet_from(m, &z_hb, o.period(), opts).map_err(cycle_err)?;
+                    let stable = c.stable;
+                    if best.is_none() || stable {
+                        best = Some((o, conv, amp, notes, c, z_hb));
+                    }
+                    if stable {
+                        break;
+                    }
+                }
+                Err(e) => failure = failure.or(Some(e)),
+            }
+        }
+        let Some(found) = best else {
+            // No orbit near this guess (a transient that only looked
+            // periodic, say): simulate on for as long again (at least 100
+            // of its periods) and settle anew.
+            if attempt >= 4 || spent >= opts.settle_time {
+                return Err(failure.expect("a guess failed"));
+            }
+            let skip = settled.max(100.0 * period);
+            (t, z) = cycle::advance(m, t + settled, zs, skip, opts).map_err(cycle_err)?;
+            spent += skip;
+            continue;
+        };
+        let c = &found.4;
+        if c.stable || attempt >= 4 || c.max_multiplier <= 1.0 || spent >= opts.settle_time {
+            break found;
+        }
+        let skip = cycle::past_unstable(c.period, c.max_multiplier);
+        (t, z) = cycle::advance(m, t + settled, zs, skip, opts).map_err(cycle_err)?;
+        spent += skip;
+    };
+    let settled = spent;
     let names = any.state_names();
     let orbit = if with_orbit {
         let period = o.period();
@@ -255,7 +330,7 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
         .enumerate()
         .map(|(i, f)| (m.contact_name(i).to_string(), *f))
         .collect();
-    let mut warnings = Vec::new();
+    let mut warnings = std::mem::take(&mut notes);
     if convergence.len() >= 2 {
         let (a, b) = (
             &convergence[convergence.len() - 2],
@@ -268,6 +343,13 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
                 a.harmonics, b.harmonics, b.amplitude_change
             ));
         }
+    }
+    if !o.converged {
+        warnings.push(format!(
+            "Newton's method stalled at a residual of {:.2e} (tolerance {:.0e}): the orbit is approximate to that",
+            o.residual,
+            HbOptions::default().newton_tol
+        ));
     }
     if o.sticks {
         warnings.push(

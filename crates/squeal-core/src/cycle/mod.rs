@@ -767,22 +767,39 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
             c.settle_time = spent;
             return Ok(c);
         }
-        let skip = c.period * (1e3f64.ln() / c.max_multiplier.ln()).min(1e6);
-        let t_here = t + settled;
-        let mut sopts = opts.solver;
-        sopts.rtol = sopts.rtol.max(opts.settle_rtol);
-        sopts.max_steps = opts.settle_steps;
-        let mut sol = Solver::new(sys, t_here, c.z0, t_here + skip, sopts)?;
-        while sol.step()?.is_some() {}
+        let skip = past_unstable(c.period, c.max_multiplier);
+        (t, z) = advance(sys, t + settled, c.z0, skip, opts)?;
         spent += skip;
-        t = sol.t();
-        z = *sol.state();
         if spent >= opts.settle_time {
             let mut c = c;
             c.settle_time = spent;
             return Ok(c);
         }
     }
+}
+
+/// How long to simulate on from an unstable periodic orbit of period `t`
+/// and largest multiplier `mu > 1` until its instability has grown a
+/// thousandfold (at most 10⁶ periods).
+pub fn past_unstable(t: f64, mu: f64) -> f64 {
+    t * (1e3f64.ln() / mu.ln()).min(1e6)
+}
+
+/// Simulate from `(t, z)` for `duration` at the settling tolerance: the
+/// time and state at the end.
+pub fn advance<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    t: f64,
+    z: [f64; N],
+    duration: f64,
+    opts: &CycleOptions,
+) -> Result<(f64, [f64; N]), CycleError> {
+    let mut sopts = opts.solver;
+    sopts.rtol = sopts.rtol.max(opts.settle_rtol);
+    sopts.max_steps = opts.settle_steps;
+    let mut sol = Solver::new(sys, t, z, t + duration, sopts)?;
+    while sol.step()?.is_some() {}
+    Ok((sol.t(), *sol.state()))
 }
 
 /// The decay rate `σ = ln μ_t / T` if the orbit `c` is no periodic orbit but
