@@ -612,6 +612,7 @@ def hb(
     scenario: Scenario = "disc-pad",
     *,
     harmonics: int = 20,
+    guess: str = "settle",
     settle_steps: int = 20_000_000,
     settle_time: float = 1000.0,
     settle_tol: float = 1e-2,
@@ -627,7 +628,10 @@ def hb(
     exact period from the HB orbit, whose scaled miss is
     ``shooting_defect``; ``convergence`` (rows for H/4, H/2, H:
     ``harmonics``, ``freq_hz``, ``amplitude_change``, ``residual``);
-    ``warnings``. ``harmonics`` is H (1…400); the settling options are
+    ``warnings``; ``guess`` (where the first guess came from). ``harmonics``
+    is H (1…400); ``guess`` is ``"settle"`` (a settled simulation, as
+    ``cycle``) or ``"hopf"`` (steady sliding's growing mode, no simulation,
+    settling only if that finds no stable orbit); the settling options are
     ``cycle``'s. Orbits that stick raise ``ScenarioError``."""
     return dict(
         json.loads(
@@ -638,6 +642,7 @@ def hb(
                 int(settle_steps),
                 float(settle_time),
                 float(settle_tol),
+                str(guess),
             )
         )
     )

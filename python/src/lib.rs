@@ -694,15 +694,18 @@ fn hb(
     settle_steps: u64,
     settle_time: f64,
     settle_tol: f64,
+    guess: &str,
 ) -> PyResult<String> {
     let sc = resolve(kind, text, &sets)?;
+    let guess = squeal_study::hb::Guess::parse(guess)
+        .map_err(|e| study_err(squeal_study::StudyError::Input(e)))?;
     squeal_study::hb::check_harmonics(harmonics)
         .map_err(|e| study_err(squeal_study::StudyError::Input(e)))?;
     let opts =
         squeal_study::cycle::checked_options(&sc, settle_steps, settle_time, settle_tol, None)
             .map_err(study_err)?;
     let found = compute(py, |cancel| {
-        squeal_study::hb::of_scenario(&sc, harmonics, &opts, false, cancel)
+        squeal_study::hb::of_scenario(&sc, harmonics, &opts, guess, false, cancel)
     })?;
     let mut doc = found.to_json();
     doc["scenario"] = sc.to_json();

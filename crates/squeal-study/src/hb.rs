@@ -81,8 +81,10 @@ pub struct HbFound {
     pub residual: f64,
     /// Newton iterations of the final solution.
     pub iterations: usize,
-    /// Simulated settling time of the guess (s).
+    /// Simulated settling time of the guess (s; 0 from the Hopf guess).
     pub settle_time: f64,
+    /// Where the guess that gave the orbit came from.
+    pub guess: Guess,
     /// What the numbers do not support, if anything.
     pub warnings: Vec<String>,
     /// One period, if asked for: the series sampled at `16(2H+1)` phases
@@ -209,12 +211,157 @@ fn ladder<M: System<N> + ?Sized, const N: usize>(
     Ok((o, convergence, amp, notes))
 }
 
+/// Where `squeal hb` takes its first guess from (`--guess`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Guess {
+    /// The last turn of a settled simulation (as `squeal cycle`): the orbit
+    /// the scenario's motion settles on.
+    Settle,
+    /// Steady sliding's fastest-growing mode at the amplitude where the
+    /// linear motion first reaches a nonlinearity (a contact's sliding
+    /// velocity or normal force reaching zero), no simulation; the settled
+    /// guess if that finds no stable orbit.
+    Hopf,
+}
+
+impl Guess {
+    /// Parse `settle` or `hopf`.
+    pub fn parse(s: &str) -> Result<Guess, InputError> {
+        match s {
+            "settle" => Ok(Guess::Settle),
+            "hopf" => Ok(Guess::Hopf),
+            other => Err(InputError(format!(
+                "--guess {other}: must be settle or hopf"
+            ))),
+        }
+    }
+
+    /// The name (`settle`, `hopf`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Guess::Settle => "settle",
+            Guess::Hopf => "hopf",
+        }
+    }
+}
+
+/// The guess from steady sliding's fastest-growing mode `u` (eigenvalue
+/// `σ + iω`): `q = q* + A·Re(u e^{iωt})`, with `A` the amplitude at which
+/// the linear motion first takes a contact's sliding velocity or normal
+/// force to zero (each is affine in the state near steady sliding, so its
+/// linear variation is exact by differences), times `factor`. `None` if
+/// steady sliding has no growing oscillatory mode.
+fn hopf_guess<M: System<N> + ?Sized, const N: usize>(
+    m: &M,
+    real: &[usize],
+    factor: f64,
+) -> Result<Option<Fourier>, StudyError> {
+    let a = squeal_core::stability::analyse(m)
+        .map_err(|e| StudyError::Numerical(format!("hb --guess hopf: {e}")))?;
+    let Some(e) = a
+        .eigen
+        .iter()
+        .filter(|e| e.growing && e.im > 0.0)
+        .max_by(|x, y| x.re.total_cmp(&y.re))
+    else {
+        return Ok(None);
+    };
+    let mut zs = [0.0; N];
+    zs.copy_from_slice(&a.equilibrium);
+    let t_a = cycle::autonomous_from(m);
+    let modes = m.start_modes(t_a, &zs);
+    let h = 1e-8;
+    let along = |part: fn(&nalgebra::Complex<f64>) -> f64| {
+        let mut z = zs;
+        for (zi, ui) in z.iter_mut().zip(&e.vector) {
+            *zi += h * part(ui);
+        }
+        z
+    };
+    let (z_re, z_im) = (along(|c| c.re), along(|c| c.im));
+    let mut amplitude = f64::INFINITY;
+    for i in 0..m.contacts() {
+        let o0 = m.observe_contact(t_a, &modes, &zs, i);
+        let (or, oi) = (
+            m.observe_contact(t_a, &modes, &z_re, i),
+            m.observe_contact(t_a, &modes, &z_im, i),
+        );
+        let gv = ((or.v_rel - o0.v_rel) / h).hypot((oi.v_rel - o0.v_rel) / h);
+        let gn = ((or.normal_force - o0.normal_force) / h)
+            .hypot((oi.normal_force - o0.normal_force) / h);
+        if gv > 0.0 {
+            amplitude = amplitude.min(o0.v_rel.abs() / gv);
+        }
+        if gn > 0.0 && o0.normal_force > 0.0 {
+            amplitude = amplitude.min(o0.normal_force / gn);
+        }
+    }
+    if !(amplitude.is_finite() && amplitude > 0.0) {
+        return Ok(None);
+    }
+    let amp = factor * amplitude;
+    let coeffs = real[..real.len() / 2]
+        .iter()
+        .map(|&i| {
+            let mut c = vec![0.0; 3];
+            c[0] = zs[i];
+            c[1] = amp * e.vector[i].re;
+            c[2] = -amp * e.vector[i].im;
+            c
+        })
+        .collect();
+    Ok(Some(Fourier {
+        omega: e.im,
+        coeffs,
+    }))
+}
+
+/// The HB orbit from the Hopf guess at amplitude factors 1, 2 and 0.5 of
+/// the first nonlinearity: the first that converges to a stable orbit.
+#[allow(clippy::type_complexity)]
+fn from_hopf<M: System<N> + ?Sized, const N: usize>(
+    m: &M,
+    real: &[usize],
+    harmonics: usize,
+    opts: &CycleOptions,
+    cancel: &Cancel,
+) -> Result<Option<Solved<N>>, StudyError> {
+    for factor in [1.0, 2.0, 0.5] {
+        let Some(g) = hopf_guess(m, real, factor)? else {
+            return Ok(None);
+        };
+        let Ok((o, conv, amp, notes)) = ladder(m, &g.resized(harmonics), harmonics, real, cancel)
+        else {
+            continue;
+        };
+        let z_hb: [f64; N] = o.fourier.state(0.0);
+        let Ok(c) = cycle::floquet_from(m, &z_hb, o.period(), opts) else {
+            continue;
+        };
+        if c.stable {
+            return Ok(Some((o, conv, amp, notes, c, z_hb)));
+        }
+    }
+    Ok(None)
+}
+
+/// An HB orbit with its table, amplitudes, notes, Floquet analysis and start.
+type Solved<const N: usize> = (
+    HbOrbit,
+    Vec<Truncation>,
+    [f64; N],
+    Vec<String>,
+    cycle::Cycle<N>,
+    [f64; N],
+);
+
 fn solve<M: System<N> + ?Sized, const N: usize>(
     m: &M,
     any: &crate::AnyModel,
     z0: &[f64],
     harmonics: usize,
     opts: &CycleOptions,
+    guess: Guess,
     with_orbit: bool,
     cancel: &Cancel,
 ) -> Result<HbFound, StudyError> {
@@ -229,72 +376,92 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
     let (mut t, mut z) = (0.0, start);
     let mut spent = 0.0;
     let mut attempt = 0;
-    let (o, convergence, amp, mut notes, c, z_hb) = loop {
-        attempt += 1;
-        let (_, zs, period, settled) = cycle::settle(m, t, z, opts).map_err(cycle_err)?;
-        spent += settled;
-        cancel.check()?;
-        let orbit = cycle::sample_period(m, &zs, period, opts).map_err(cycle_err)?;
-        if let Some(k) = orbit.modes.iter().find_map(|md| {
-            md.as_slice()
-                .iter()
-                .position(|&x| x == squeal_core::Mode::Stick)
-        }) {
-            return Err(StudyError::Input(InputError(format!(
+    let hopf = match guess {
+        Guess::Hopf => from_hopf(m, &real, harmonics, opts, cancel)?,
+        Guess::Settle => None,
+    };
+    let from = if hopf.is_some() {
+        Guess::Hopf
+    } else {
+        Guess::Settle
+    };
+    let hopf_failed = guess == Guess::Hopf && hopf.is_none();
+    let (o, convergence, amp, mut notes, c, z_hb) = if let Some(found) = hopf {
+        found
+    } else {
+        loop {
+            attempt += 1;
+            let (_, zs, period, settled) = cycle::settle(m, t, z, opts).map_err(cycle_err)?;
+            spent += settled;
+            cancel.check()?;
+            let orbit = cycle::sample_period(m, &zs, period, opts).map_err(cycle_err)?;
+            if let Some(k) = orbit.modes.iter().find_map(|md| {
+                md.as_slice()
+                    .iter()
+                    .position(|&x| x == squeal_core::Mode::Stick)
+            }) {
+                return Err(StudyError::Input(InputError(format!(
                 "hb: the orbit the scenario settles on sticks (contact {}): harmonic balance here treats friction as slip and contact loss exactly, but a sticking contact's force is a constraint force (a dynamic Lagrangian scheme, not built); use squeal cycle",
                 m.contact_name(k)
             ))));
-        }
-        // Fitted with enough harmonics to see whether the settled "period"
-        // is several turns of the orbit (the turns of a settling run agree
-        // to its tolerance only: up to 1e-2 of the energy may leak into
-        // the other harmonics); tried at the minimal period first, then,
-        // if that orbit is not the stable one, at the settled period (a
-        // genuine period-k orbit, near a period doubling say).
-        let full = Fourier::from_orbit(&orbit, period, n, 4 * harmonics.max(8));
-        let reduced = full.minimal(1e-2);
-        let mut guesses = vec![reduced.resized(harmonics)];
-        if reduced.omega != full.omega {
-            guesses.push(full.resized(harmonics));
-        }
-        let mut best = None;
-        let mut failure = None;
-        for g in &guesses {
-            match ladder(m, g, harmonics, &real, cancel) {
-                Ok((o, conv, amp, notes)) => {
-                    let z_hb: [f64; N] = o.fourier.state(0.0);
-                    let c = cycle::floquet_from(m, &z_hb, o.period(), opts).map_err(cycle_err)?;
-                    let stable = c.stable;
-                    if best.is_none() || stable {
-                        best = Some((o, conv, amp, notes, c, z_hb));
+            }
+            // Fitted with enough harmonics to see whether the settled "period"
+            // is several turns of the orbit (the turns of a settling run agree
+            // to its tolerance only: up to 1e-2 of the energy may leak into
+            // the other harmonics); tried at the minimal period first, then,
+            // if that orbit is not the stable one, at the settled period (a
+            // genuine period-k orbit, near a period doubling say).
+            let full = Fourier::from_orbit(&orbit, period, n, 4 * harmonics.max(8));
+            let reduced = full.minimal(1e-2);
+            let mut guesses = vec![reduced.resized(harmonics)];
+            if reduced.omega != full.omega {
+                guesses.push(full.resized(harmonics));
+            }
+            let mut best = None;
+            let mut failure = None;
+            for g in &guesses {
+                match ladder(m, g, harmonics, &real, cancel) {
+                    Ok((o, conv, amp, notes)) => {
+                        let z_hb: [f64; N] = o.fourier.state(0.0);
+                        let c =
+                            cycle::floquet_from(m, &z_hb, o.period(), opts).map_err(cycle_err)?;
+                        let stable = c.stable;
+                        if best.is_none() || stable {
+                            best = Some((o, conv, amp, notes, c, z_hb));
+                        }
+                        if stable {
+                            break;
+                        }
                     }
-                    if stable {
-                        break;
-                    }
+                    Err(e) => failure = failure.or(Some(e)),
                 }
-                Err(e) => failure = failure.or(Some(e)),
             }
-        }
-        let Some(found) = best else {
-            // No orbit near this guess (a transient that only looked
-            // periodic, say): simulate on for as long again (at least 100
-            // of its periods) and settle anew.
-            if attempt >= 4 || spent >= opts.settle_time {
-                return Err(failure.expect("a guess failed"));
+            let Some(found) = best else {
+                // No orbit near this guess (a transient that only looked
+                // periodic, say): simulate on for as long again (at least 100
+                // of its periods) and settle anew.
+                if attempt >= 4 || spent >= opts.settle_time {
+                    return Err(failure.expect("a guess failed"));
+                }
+                let skip = settled.max(100.0 * period);
+                (t, z) = cycle::advance(m, t + settled, zs, skip, opts).map_err(cycle_err)?;
+                spent += skip;
+                continue;
+            };
+            let c = &found.4;
+            if c.stable || attempt >= 4 || c.max_multiplier <= 1.0 || spent >= opts.settle_time {
+                break found;
             }
-            let skip = settled.max(100.0 * period);
+            let skip = cycle::past_unstable(c.period, c.max_multiplier);
             (t, z) = cycle::advance(m, t + settled, zs, skip, opts).map_err(cycle_err)?;
             spent += skip;
-            continue;
-        };
-        let c = &found.4;
-        if c.stable || attempt >= 4 || c.max_multiplier <= 1.0 || spent >= opts.settle_time {
-            break found;
         }
-        let skip = cycle::past_unstable(c.period, c.max_multiplier);
-        (t, z) = cycle::advance(m, t + settled, zs, skip, opts).map_err(cycle_err)?;
-        spent += skip;
     };
+    if hopf_failed {
+        notes.push(
+            "--guess hopf found no stable orbit from steady sliding's growing mode; the guess was settled by simulation instead".into(),
+        );
+    }
     let settled = spent;
     let names = any.state_names();
     let orbit = if with_orbit {
@@ -393,6 +560,7 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
         residual: o.residual,
         iterations: o.iterations,
         settle_time: settled,
+        guess: from,
         warnings,
         orbit,
         names,
@@ -402,11 +570,13 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
 /// The harmonic-balance orbit of a scenario with `harmonics` harmonics,
 /// its guess settled from the scenario's initial state with `opts` (those
 /// of `squeal cycle`, [`crate::cycle::checked_options`]); `with_orbit`:
-/// also one period of the series and of the exact flow from it.
+/// also one period of the series and of the exact flow from it; `guess`:
+/// where the first guess comes from ([`Guess`]).
 pub fn of_scenario(
     sc: &Scenario,
     harmonics: usize,
     opts: &CycleOptions,
+    guess: Guess,
     with_orbit: bool,
     cancel: &Cancel,
 ) -> Result<HbFound, StudyError> {
@@ -414,7 +584,7 @@ pub fn of_scenario(
     cancel.check()?;
     crate::with_sim_system!(&sc.model, m => {
         let z0 = crate::run::initial_of(m, sc)?;
-        solve(m, &sc.model, &z0, harmonics, opts, with_orbit, cancel)
+        solve(m, &sc.model, &z0, harmonics, opts, guess, with_orbit, cancel)
     }, else => Err(StudyError::Input(InputError(sc.model.check_cycle_size().err().unwrap_or_default()))))
 }
 
@@ -481,6 +651,7 @@ impl HbFound {
             "residual": self.residual,
             "newton_iterations": self.iterations,
             "settle_time": self.settle_time,
+            "guess": self.guess.as_str(),
             "warnings": self.warnings,
         })
     }

@@ -112,6 +112,9 @@ fn hb_refuses_what_it_cannot_do_in_one_line() {
     );
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(out.stdout.is_empty());
+    let out = squeal(d.path(), &["hb", "hoffmann", "--guess", "guess"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--guess guess"));
     for h in ["0", "401"] {
         let out = squeal(d.path(), &["hb", "hoffmann", "--harmonics", h]);
         assert_eq!(out.status.code(), Some(2));
@@ -149,4 +152,25 @@ fn hb_finds_the_orbit_cycle_settles_on() {
         );
         assert!((mh - mc).abs() <= 1e-5, "{s}: {mh} vs {mc}");
     }
+}
+
+/// `--guess hopf`: no simulation; Hoffmann's orbit from steady sliding's
+/// growing mode at the amplitude where the normal force first reaches zero
+/// is the shooting cycle's (measured 1.5e-10).
+#[test]
+fn hb_from_the_hopf_guess_needs_no_settling() {
+    let d = tempfile::tempdir().unwrap();
+    let hb = json_of(&squeal(
+        d.path(),
+        &["hb", "hoffmann", "--guess", "hopf", "--json"],
+    ));
+    let cy = json_of(&squeal(d.path(), &["cycle", "hoffmann", "--json"]));
+    assert_eq!(hb["guess"], "hopf");
+    assert_eq!(hb["settle_time"].as_f64(), Some(0.0));
+    let (fh, fc) = (
+        hb["freq_hz"].as_f64().unwrap(),
+        cy["frequency_hz"].as_f64().unwrap(),
+    );
+    assert!((fh / fc - 1.0).abs() <= 1e-8, "{fh} vs {fc}");
+    assert_eq!(hb["stable"], true);
 }

@@ -342,7 +342,7 @@ fn saltation<S: System<N> + ?Sized, const N: usize>(
 
 /// The time from which the model is autonomous (after its last breakpoint,
 /// e.g. the end of a load ramp): every period is integrated from there.
-pub(crate) fn autonomous_from<S: System<N> + ?Sized, const N: usize>(sys: &S) -> f64 {
+pub fn autonomous_from<S: System<N> + ?Sized, const N: usize>(sys: &S) -> f64 {
     let mut t = 0.0;
     for _ in 0..1000 {
         match sys.breakpoint_after(t) {

@@ -30,6 +30,11 @@ pub struct HbArgs {
     /// Settled when two returns to the section agree to this (relative).
     #[arg(long, default_value_t = CycleOptions::default().settle_tol)]
     pub settle_tol: f64,
+    /// Where the first guess comes from: `settle` (a settled simulation, the
+    /// orbit the scenario's motion settles on) or `hopf` (steady sliding's
+    /// growing mode, no simulation; settles if that finds no stable orbit).
+    #[arg(long, default_value = "settle")]
+    pub guess: String,
     /// Print the result as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -159,7 +164,8 @@ pub fn run(a: HbArgs) -> Result<(), RunError> {
     squeal_study::hb::check_harmonics(a.harmonics)?;
     let opts = checked_options(&sc, a.settle_steps, a.settle_time, a.settle_tol, None)?;
     let stage = a.out.as_deref().map(Staging::new).transpose()?;
-    let found = of_scenario(&sc, a.harmonics, &opts, a.out.is_some(), &NEVER)?;
+    let guess = squeal_study::hb::Guess::parse(&a.guess)?;
+    let found = of_scenario(&sc, a.harmonics, &opts, guess, a.out.is_some(), &NEVER)?;
     let mut doc = found.to_json();
     doc["scenario"] = sc.to_json();
     if let Some(stage) = stage {
