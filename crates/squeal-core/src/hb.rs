@@ -288,10 +288,8 @@ impl Fourier {
     pub fn state<const N: usize>(&self, theta: f64) -> [f64; N] {
         let n = self.coeffs.len();
         let mut z = [0.0; N];
-        let (mut q, mut v) = (vec![0.0; n], vec![0.0; n]);
-        self.eval(theta, &mut q, &mut v);
-        z[..n].copy_from_slice(&q);
-        z[N / 2..N / 2 + n].copy_from_slice(&v);
+        let (q, v) = z.split_at_mut(N / 2);
+        self.eval(theta, &mut q[..n], &mut v[..n]);
         z
     }
 }
@@ -459,9 +457,7 @@ impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
     fn project(&self, f: &Fourier, pieces: &[Piece], proj: &mut [f64]) {
         let (n, h, w) = (self.n, self.h, self.width());
         proj.fill(0.0);
-        let mut z = [0.0; N];
         let mut dz = [0.0; N];
-        let (mut q, mut v) = (vec![0.0; n], vec![0.0; n]);
         let mut cs = vec![(0.0, 0.0); h + 1];
         for pc in pieces {
             let (mid, half) = (0.5 * (pc.a + pc.b), 0.5 * (pc.b - pc.a));
@@ -471,9 +467,7 @@ impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
             for &(xg, wg) in &GAUSS {
                 let th = mid + half * xg;
                 let wt = half * wg;
-                f.eval(th, &mut q, &mut v);
-                z[..n].copy_from_slice(&q);
-                z[N / 2..N / 2 + n].copy_from_slice(&v);
+                let z: [f64; N] = f.state(th);
                 self.sys.field(self.t_a, &pc.modes, &z, &mut dz);
                 let (s1, c1) = th.sin_cos();
                 cs[0] = (1.0, 0.0);

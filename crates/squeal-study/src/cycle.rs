@@ -263,36 +263,39 @@ impl Found {
     /// The JSON document (`period`, `multipliers`, `stable`, `amplitude`,
     /// `events_per_period`, `residual`, …).
     pub fn to_json(&self) -> Value {
-        let multipliers: Vec<Value> = self
-            .multipliers
-            .iter()
-            .map(|&(re, im, trivial)| {
-                json!({ "re": re, "im": im, "abs": re.hypot(im), "trivial": trivial })
-            })
-            .collect();
-        let mut amplitude = Map::new();
-        for (n, a) in self.names.iter().zip(&self.amplitude) {
-            amplitude.insert(n.clone(), json!(a));
-        }
-        let mut start = Map::new();
-        for (n, z) in self.names.iter().zip(&self.z0) {
-            start.insert(n.clone(), json!(z));
-        }
         json!({
             "period": self.period,
             "frequency_hz": 1.0 / self.period,
-            "multipliers": multipliers,
+            "multipliers": multipliers_json(&self.multipliers),
             "stable": self.stable,
             "max_multiplier": self.max_multiplier,
-            "amplitude": amplitude,
+            "amplitude": named_json(&self.names, &self.amplitude),
             "events_per_period": events_json(&self.events),
             "residual": self.residual,
             "newton_iterations": self.iterations,
             "section": { "state": self.section.0, "level": self.section.1 },
-            "start": start,
+            "start": named_json(&self.names, &self.z0),
             "settle_time": self.settle_time,
         })
     }
+}
+
+/// Multipliers `(re, im, trivial)` as `[{re, im, abs, trivial}]`.
+pub fn multipliers_json(m: &[(f64, f64, bool)]) -> Value {
+    m.iter()
+        .map(|&(re, im, trivial)| {
+            json!({ "re": re, "im": im, "abs": re.hypot(im), "trivial": trivial })
+        })
+        .collect()
+}
+
+/// `{name: value}` for names and values paired in order.
+pub fn named_json<T: serde::Serialize>(names: &[String], values: &[T]) -> Value {
+    let mut m = Map::new();
+    for (n, v) in names.iter().zip(values) {
+        m.insert(n.clone(), json!(v));
+    }
+    Value::Object(m)
 }
 
 /// `{kind: count}` for every event kind.

@@ -12,7 +12,7 @@
 //! period, `|φ_T(z₀) − z₀|`, measures how far the HB orbit is from a
 //! periodic orbit of the exact model.
 
-use crate::cycle::{events_json, real_states};
+use crate::cycle::{events_json, multipliers_json, named_json, real_states};
 use crate::error::{Cancel, StudyError};
 use crate::scenario::{InputError, Scenario};
 use serde_json::{json, Map, Value};
@@ -596,21 +596,6 @@ impl HbFound {
     /// `harmonic_count`, `contact_modes`, `convergence`, `shooting_defect`
     /// and `warnings`.
     pub fn to_json(&self) -> Value {
-        let multipliers: Vec<Value> = self
-            .multipliers
-            .iter()
-            .map(|&(re, im, trivial)| {
-                json!({ "re": re, "im": im, "abs": re.hypot(im), "trivial": trivial })
-            })
-            .collect();
-        let mut amplitude = Map::new();
-        for (n, a) in self.names.iter().zip(&self.amplitude) {
-            amplitude.insert(n.clone(), json!(a));
-        }
-        let mut harmonics = Map::new();
-        for (n, s) in self.names.iter().zip(&self.spectrum) {
-            harmonics.insert(n.clone(), json!(s));
-        }
         let mut modes = Map::new();
         for (name, f) in &self.fractions {
             modes.insert(
@@ -637,10 +622,10 @@ impl HbFound {
             "freq_hz": 1.0 / self.period,
             "frequency_hz": 1.0 / self.period,
             "harmonic_count": self.harmonics,
-            "harmonics": harmonics,
-            "amplitude": amplitude,
+            "harmonics": named_json(&self.names, &self.spectrum),
+            "amplitude": named_json(&self.names, &self.amplitude),
             "stable": self.stable,
-            "multipliers": multipliers,
+            "multipliers": multipliers_json(&self.multipliers),
             "max_multiplier": self.max_multiplier,
             "events_per_period": events_json(&self.events),
             "shooting_defect": self.defect,

@@ -1,25 +1,7 @@
 //! `squeal hb` end to end: the JSON against `squeal cycle`'s on the same
 //! scenario (frequency, amplitudes, multipliers), and what it refuses.
 
-use std::path::Path;
-use std::process::{Command, Output};
-
-fn squeal(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_squeal"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("squeal runs")
-}
-
-fn json_of(out: &Output) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
+use crate::cli_common::{json as json_of, refused, squeal};
 
 /// Hoffmann's two-dof model with contact loss (no stick, no reversal):
 /// HB at H = 20 against shooting.
@@ -103,22 +85,15 @@ fn hoffmann_hb_equals_the_shooting_cycle() {
 fn hb_refuses_what_it_cannot_do_in_one_line() {
     let d = tempfile::tempdir().unwrap();
     // The thesis law's belt settles on stick-slip.
-    let out = squeal(d.path(), &["hb", "belt"]);
-    assert_eq!(out.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = refused(&squeal(d.path(), &["hb", "belt"]));
     assert!(
         err.contains("sticks") && err.contains("squeal cycle"),
         "{err}"
     );
-    assert_eq!(err.trim().lines().count(), 1, "{err}");
-    assert!(out.stdout.is_empty());
-    let out = squeal(d.path(), &["hb", "hoffmann", "--guess", "guess"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--guess guess"));
+    let err = refused(&squeal(d.path(), &["hb", "hoffmann", "--guess", "guess"]));
+    assert!(err.contains("--guess guess"), "{err}");
     for h in ["0", "401"] {
-        let out = squeal(d.path(), &["hb", "hoffmann", "--harmonics", h]);
-        assert_eq!(out.status.code(), Some(2));
-        let err = String::from_utf8_lossy(&out.stderr);
+        let err = refused(&squeal(d.path(), &["hb", "hoffmann", "--harmonics", h]));
         assert!(err.contains(&format!("--harmonics {h}")), "{err}");
     }
     assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 0);

@@ -15,15 +15,9 @@ use squeal_study::scenario::Scenario;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-/// Arguments of `squeal cycle`.
+/// How a settling run looks for a periodic orbit (`cycle`, `hb`).
 #[derive(Args, Debug)]
-pub struct CycleArgs {
-    #[command(flatten)]
-    pub scenario: ScenarioArgs,
-    /// Poincaré section: a state name, optionally with its level
-    /// (`vx_p` or `vx_p=0.1`); default an upward zero of a velocity.
-    #[arg(long, value_name = "STATE[=LEVEL]", allow_hyphen_values = true)]
-    pub section: Option<String>,
+pub struct SettleArgs {
     /// Most integrator steps spent settling onto the cycle.
     #[arg(long, default_value_t = 20_000_000)]
     pub settle_steps: u64,
@@ -34,6 +28,19 @@ pub struct CycleArgs {
     /// the orbit's amplitude (Newton's method does the rest).
     #[arg(long, default_value_t = CycleOptions::default().settle_tol)]
     pub settle_tol: f64,
+}
+
+/// Arguments of `squeal cycle`.
+#[derive(Args, Debug)]
+pub struct CycleArgs {
+    #[command(flatten)]
+    pub scenario: ScenarioArgs,
+    /// Poincaré section: a state name, optionally with its level
+    /// (`vx_p` or `vx_p=0.1`); default an upward zero of a velocity.
+    #[arg(long, value_name = "STATE[=LEVEL]", allow_hyphen_values = true)]
+    pub section: Option<String>,
+    #[command(flatten)]
+    pub settle: SettleArgs,
     /// Print the result as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -149,9 +156,9 @@ pub fn run(a: CycleArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
     let opts = checked_options(
         &sc,
-        a.settle_steps,
-        a.settle_time,
-        a.settle_tol,
+        a.settle.settle_steps,
+        a.settle.settle_time,
+        a.settle.settle_tol,
         a.section.as_deref(),
     )?;
     let stage = a.out.as_deref().map(Staging::new).transpose()?;

@@ -1,11 +1,11 @@
 //! `squeal hb [SCENARIO] [--harmonics H] [--json]`: the self-excited
 //! periodic orbit by harmonic balance (`squeal_study::hb`).
 
+use crate::commands::cycle::SettleArgs;
 use crate::commands::simulate::resolve;
 use crate::run::{RunError, Staging, NEVER};
 use crate::ScenarioArgs;
 use clap::Args;
-use squeal_core::cycle::CycleOptions;
 use squeal_plot::{Format, Panel, Series};
 use squeal_study::cycle::checked_options;
 use squeal_study::hb::{of_scenario, HbFound};
@@ -21,15 +21,8 @@ pub struct HbArgs {
     /// Harmonics kept (the table also shows H/4 and H/2).
     #[arg(long, default_value_t = 20)]
     pub harmonics: usize,
-    /// Most integrator steps spent settling onto the orbit for the guess.
-    #[arg(long, default_value_t = 20_000_000)]
-    pub settle_steps: u64,
-    /// Most simulated time spent settling (s).
-    #[arg(long, default_value_t = 1000.0, allow_hyphen_values = true)]
-    pub settle_time: f64,
-    /// Settled when two returns to the section agree to this (relative).
-    #[arg(long, default_value_t = CycleOptions::default().settle_tol)]
-    pub settle_tol: f64,
+    #[command(flatten)]
+    pub settle: SettleArgs,
     /// Where the first guess comes from: `settle` (a settled simulation, the
     /// orbit the scenario's motion settles on) or `hopf` (steady sliding's
     /// growing mode, no simulation; settles if that finds no stable orbit).
@@ -162,7 +155,13 @@ fn draw(f: &HbFound, sc: &Scenario, dir: &Path) -> Result<(), RunError> {
 pub fn run(a: HbArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
     squeal_study::hb::check_harmonics(a.harmonics)?;
-    let opts = checked_options(&sc, a.settle_steps, a.settle_time, a.settle_tol, None)?;
+    let opts = checked_options(
+        &sc,
+        a.settle.settle_steps,
+        a.settle.settle_time,
+        a.settle.settle_tol,
+        None,
+    )?;
     let stage = a.out.as_deref().map(Staging::new).transpose()?;
     let guess = squeal_study::hb::Guess::parse(&a.guess)?;
     let found = of_scenario(&sc, a.harmonics, &opts, guess, a.out.is_some(), &NEVER)?;
