@@ -39,7 +39,7 @@ pub const MAX_TABLE_BYTES: u64 = 4_000_000_000;
 pub const PIPE_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// What a path turned out to be, in words for a message.
-fn kind_of(t: std::fs::FileType) -> &'static str {
+pub fn kind_of(t: std::fs::FileType) -> &'static str {
     if t.is_dir() {
         "a folder"
     } else if t.is_char_device() {

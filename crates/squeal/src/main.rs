@@ -4,12 +4,11 @@
 //! (spectra, audio) and `squeal-plot` (pictures). Exit codes: 0 success,
 //! 1 a run failed (numerical trouble, I/O), 2 bad input.
 
-mod analysis;
 mod commands;
 mod out;
-mod output;
 mod run;
-mod staging;
+
+use squeal_files::{analysis, output, staging};
 
 use clap::{Args, Parser, Subcommand};
 use run::RunError;

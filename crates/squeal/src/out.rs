@@ -57,11 +57,7 @@ macro_rules! errln {
 /// to a sane length). A failed write (`2>/dev/full`, a closed stderr) is
 /// ignored: the run ends with its own exit code (issue 24, class 5).
 pub fn err_line(args: std::fmt::Arguments) {
-    let line = squeal_study::error::for_terminal(&args.to_string());
-    let mut e = std::io::stderr().lock();
-    let _ = e
-        .write_all(line.as_bytes())
-        .and_then(|_| e.write_all(b"\n"));
+    squeal_files::error::note(args);
 }
 
 /// Text to standard error as it is (clap's help on a missing subcommand),

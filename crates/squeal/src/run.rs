@@ -1,38 +1,14 @@
-//! The command line's side of a run: its error type (with exit codes), the
-//! progress bar, and a timed call of [`squeal_study::run::run`] (outputs are
-//! staged by [`crate::staging::Staging`], re-exported here).
+//! The command line's side of a run: the progress bar, and a timed call of
+//! [`squeal_study::run::run`] (the error type, [`squeal_files::RunError`],
+//! and the staged output, [`squeal_files::Staging`], are re-exported here).
 
 use indicatif::{ProgressBar, ProgressStyle};
-use squeal_study::{Cancel, InputError, Progress, Scenario, StudyError};
+use squeal_study::{Cancel, Progress, Scenario};
 use std::io::IsTerminal;
 use std::time::Instant;
 
-pub use crate::staging::Staging;
+pub use squeal_files::{RunError, Staging};
 pub use squeal_study::run::Run;
-
-/// Why a command failed: bad input (exit code 2) or trouble during the run (exit code 1).
-#[derive(Debug, thiserror::Error)]
-pub enum RunError {
-    /// Bad input, detected before anything was written.
-    #[error(transparent)]
-    Input(#[from] InputError),
-    /// Numerical failure (step underflow, chatter, …) with its time and cause.
-    #[error("simulation failed: {0}")]
-    Numerical(String),
-    /// Writing output failed.
-    #[error("{0}")]
-    Io(String),
-}
-
-impl From<StudyError> for RunError {
-    fn from(e: StudyError) -> Self {
-        match e {
-            StudyError::Input(e) => RunError::Input(e),
-            StudyError::Numerical(s) => RunError::Numerical(s),
-            StudyError::Interrupted => RunError::Io("interrupted".into()),
-        }
-    }
-}
 
 /// The CLI never cancels a computation: SIGINT and SIGTERM end the process
 /// (after removing its staging entries, see [`crate::staging`]).
@@ -48,6 +24,12 @@ impl Progress for Bar {
     fn finish(&self) {
         self.0.finish_and_clear();
     }
+}
+
+/// A progress bar on a terminal, nothing otherwise, as the files layer's
+/// [`squeal_files::Bars`] want it.
+pub fn bars(len: u64, what: &str) -> Box<dyn Progress> {
+    Box::new(progress_bar(len, what))
 }
 
 /// A progress bar on a terminal, nothing otherwise.

@@ -22,11 +22,6 @@ pub struct ReduceArgs {
     json: bool,
 }
 
-fn write(path: &std::path::Path, text: &str) -> Result<(), RunError> {
-    std::fs::write(path, text)
-        .map_err(|e| RunError::Io(format!("cannot write {}: {e}", path.display())))
-}
-
 /// Run the command.
 pub fn run(a: ReduceArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
@@ -53,38 +48,7 @@ pub fn run(a: ReduceArgs) -> Result<(), RunError> {
     }
     let red = squeal_study::reduce::reduce(&sc)?;
     let stage = Staging::for_out(a.out.as_deref(), &red.name)?;
-    write(&stage.path("scenario.toml"), &red.toml)?;
-    write(
-        &stage.path("M.mtx"),
-        &squeal_core::matrix_market::write(&red.m),
-    )?;
-    write(
-        &stage.path("K.mtx"),
-        &squeal_core::matrix_market::write(&red.k),
-    )?;
-    if let Some(c) = &red.c {
-        write(&stage.path("C.mtx"), &squeal_core::matrix_market::write(c))?;
-    }
-    let doc = serde_json::to_value(&red).map_err(|e| RunError::Io(e.to_string()))?;
-    crate::output::write_json(&doc, &stage.path("reduce.json"))?;
-    // What was written must read back as the model it describes.
-    let path = stage.path("scenario.toml");
-    let back = squeal_study::scenario::resolve(
-        squeal_study::scenario::Source::Spec(&path.to_string_lossy()),
-        &[],
-    )
-    .map_err(|e| {
-        RunError::Io(format!(
-            "reduce: the reduced scenario does not read back: {e}"
-        ))
-    })?;
-    if (back.model.state_names().len() / 2) != red.reduced_dofs() {
-        return Err(RunError::Io(format!(
-            "reduce: the reduced scenario reads back with {} dofs, not {}",
-            (back.model.state_names().len() / 2),
-            red.reduced_dofs()
-        )));
-    }
+    let doc = squeal_files::reduce::write(&stage, &red)?;
     let dir = stage.commit()?;
     if a.json {
         crate::outln!(

@@ -126,61 +126,24 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
     let stage = Staging::for_out(a.out.as_deref(), &sc.name)?;
     let run = run::run(&sc)?;
     let t0 = Instant::now();
-    if csv {
-        output::write_series_csv(&run, &stage.path("series.csv"))?;
-    }
-    if npy {
-        output::write_series_npy(&run, &stage.path("series.npy"))?;
-    }
-    output::write_events_csv(&run, &stage.path("events.csv"))?;
-    let channels = sc.model.channels();
-    let an = analysis::analyse(
-        &run,
-        &channels,
-        &spectrum_settings,
-        sc.validity,
-        a.spectrum.signals(),
-    );
-    analysis::write_spectrum_csv(&an, &stage.path("spectrum.csv"))?;
-    let answer = squeal_study::answer::Answer::of(&sc, &run, &an);
-    let mut summary = squeal_study::answer::summary_json_with(&sc, &run, &an, &answer);
-    if !a.no_plots {
-        let band = plot_settings.around_squeal(
-            answer.squeal.as_ref().map(|s| s.frequency_hz),
-            run.sample_rate,
-        );
-        let words = answer.squeal.as_ref().map(|s| s.words());
-        if let Some(note) = analysis::draw(
-            &run,
-            &an,
-            &channels,
-            &sc.name,
-            stage.dir(),
-            &band,
-            words.as_deref(),
-            !a.spectrum.signals().is_empty(),
-        )? {
-            crate::errln!("{note}");
-        }
-    }
-    let mut hearing = None;
-    if a.wav {
-        let sound = analysis::SoundSettings::default();
-        let signal = analysis::default_sound_signal(&run, &an.judgement)
-            .unwrap_or_else(|| channels.tangential.to_string());
-        if let Some(x) = run.column(&signal) {
-            let clip =
-                analysis::write_wav(x, run.sample_rate, &stage.path("squeal.wav"), false, &sound)?;
-            if clip.looped {
-                crate::errln!(
-                    "note: the run ({:.3} s) is shorter than the 2 s of sound: its last steady part is looped",
-                    clip.source_seconds
-                );
-            }
-            summary["audio"] = sound.json(&signal, &clip);
-            crate::errln!("squeal.wav: {signal}, {}", sound.describe(&clip));
-            hearing = analysis::hearing_note(&an.judgement, &sound);
-        }
+    let files = squeal_files::run_dir::RunFiles {
+        csv,
+        npy,
+        plots: !a.no_plots,
+        wav: a.wav,
+        spectrum: &spectrum_settings,
+        plot: &plot_settings,
+        signals: a.spectrum.signals(),
+    };
+    let squeal_files::run_dir::RunWritten {
+        analysis: an,
+        answer,
+        mut summary,
+        notes,
+        hearing,
+    } = squeal_files::run_dir::write_run(&stage, &sc, &run, &files)?;
+    for note in notes {
+        crate::errln!("{note}");
     }
     let output_s = t0.elapsed().as_secs_f64();
     summary["timing"] = json!({ "integrate_s": run.integrate_s, "output_s": output_s });

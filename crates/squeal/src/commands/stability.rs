@@ -10,8 +10,7 @@ use crate::ScenarioArgs;
 use clap::Args;
 use squeal_core::stability::Analysis;
 use squeal_study::levers::{lever_keys, Levers};
-use squeal_study::model::AnyModel;
-use squeal_study::stability::{analyse, document, shape_of};
+use squeal_study::stability::{analyse, document};
 
 /// Arguments of `squeal stability`.
 #[derive(Args, Debug)]
@@ -28,42 +27,6 @@ pub struct StabilityArgs {
     /// seconds for a few hundred dofs).
     #[arg(long)]
     no_levers: bool,
-}
-
-/// Write `modes.csv`: one row per mode and position dof,
-/// `mode,growth_rate,freq_hz,damping_ratio,dof,amplitude,phase_deg`, modes
-/// numbered as in the table (by growth rate).
-pub fn write_modes_csv(
-    path: &std::path::Path,
-    model: &AnyModel,
-    an: &Analysis,
-) -> Result<(), RunError> {
-    use std::io::Write;
-    let io = |e: std::io::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
-    writeln!(
-        w,
-        "mode,growth_rate,freq_hz,damping_ratio,dof,amplitude,phase_deg"
-    )
-    .map_err(io)?;
-    let names = model.state_names();
-    for (k, e) in an.eigen.iter().enumerate() {
-        for (i, (amp, ph)) in shape_of(e).into_iter().enumerate() {
-            writeln!(
-                w,
-                "{},{:e},{:e},{:e},{},{:e},{:e}",
-                k + 1,
-                e.re,
-                e.freq_hz,
-                e.damping_ratio,
-                names.get(i).map_or("", String::as_str),
-                amp,
-                ph
-            )
-            .map_err(io)?;
-        }
-    }
-    w.flush().map_err(io)
 }
 
 /// One line saying that the analysis is a reduced-basis one, if it is.
@@ -104,7 +67,7 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         analyse(&sc.model).map_err(|e| squeal_study::feasible::stability_failure(&sc.model, e))?;
     if let Some(dest) = &a.out {
         let stage = crate::run::Staging::new_as("--out", dest)?;
-        write_modes_csv(&stage.path("modes.csv"), &sc.model, &an)?;
+        squeal_files::modes::write_modes_csv(&stage.path("modes.csv"), &sc.model, &an)?;
         stage.commit()?;
     }
     let levers = if a.no_levers {

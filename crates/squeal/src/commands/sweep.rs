@@ -3,7 +3,6 @@
 //! continuously by shape (`squeal_core::stability::sweep`), written as
 //! `sweep.csv` and drawn as the mode-coupling diagram (`sweep.png/.svg`).
 
-use crate::commands::merge::Shard;
 use crate::commands::simulate::resolve;
 use crate::run::{RunError, Staging, NEVER};
 use crate::ScenarioArgs;
@@ -11,10 +10,9 @@ use clap::Args;
 use serde_json::json;
 use squeal_core::stability::sweep::Sweep;
 use squeal_core::stability::Direction;
-use squeal_plot::{BranchSeries, Format, ModeCouplingSpec};
-use squeal_study::map::{parse_axis, unit_of, Axis};
-use squeal_study::sweep::sweep_model;
-use std::io::Write;
+use squeal_files::shard::Shard;
+use squeal_files::sweep::{SweepResult, SweepStudy};
+use squeal_study::map::parse_axis;
 use std::path::PathBuf;
 
 /// Arguments of `squeal sweep`.
@@ -39,168 +37,45 @@ pub struct SweepArgs {
     pub shard: Option<String>,
 }
 
-fn num(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x:e}")
-    } else {
-        "nan".into()
-    }
-}
-
 /// Run the command.
 pub fn run(a: SweepArgs) -> Result<(), RunError> {
     let sc = resolve(&a.scenario)?;
     let axis = parse_axis(&a.param, "--param", false, &sc.model)?;
     let shard = a.shard.as_deref().map(Shard::parse).transpose()?;
-    if let Some(s) = shard {
-        if s.n > axis.values.len() {
-            return Err(squeal_study::scenario::InputError(format!(
-                "--shard {}/{}: more shards than the {} values of --param {}",
-                s.k,
-                s.n,
-                axis.values.len(),
-                a.param
-            ))
-            .into());
-        }
-    }
-    let name = Shard::folder(&format!("{}-sweep", sc.name), shard);
-    let stage = Staging::for_out(a.out.as_deref(), &name)?;
-    if let Some(p) = squeal_study::plan::plan(&sc, "sweep", axis.values.len()) {
+    let study = SweepStudy::new(sc, axis, &a.param, shard)?;
+    let stage = Staging::for_out(a.out.as_deref(), &study.folder())?;
+    let n = study.param.values.len();
+    if let Some(p) = squeal_study::plan::plan(&study.sc, "sweep", n) {
         crate::errln!("{p}");
     }
-    let unit = unit_of(&sc.model, &axis.name);
-    let xl = if unit.is_empty() {
-        axis.name.clone()
-    } else {
-        format!("{} ({unit})", axis.name)
-    };
-    if let Some(s) = shard {
-        use squeal_study::sweep::shard::{part_of, slice};
-        let (_, computed) = slice(axis.values.len(), s.k, s.n);
-        let sw = sweep_model(
-            &sc.model,
-            &axis.name,
-            &axis.values[computed.clone()],
-            &a.param,
-            &NEVER,
-        )?;
-        let part = part_of(&axis.values, s.k, s.n, &sw);
-        let study = crate::commands::merge::sweep_study(&sc, &axis, &xl);
-        crate::commands::merge::write_sweep_part(&stage, &study, s, &part)?;
-        let out = stage.commit()?;
-        let (own, _) = slice(axis.values.len(), s.k, s.n);
-        if a.json {
-            let doc = json!({ "shard": s.k, "shards": s.n, "values": own.len(), "first": own.start, "computed_from": computed.start, "out": out });
-            crate::outln!(
-                "{}",
-                serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
-            );
-        } else {
-            crate::outln!(
-                "{}: shard {}/{} — values {}–{} of {} (tracked from value {}); output: {} (shard.json, part.json); gather with `squeal merge`",
-                sc.name,
-                s.k,
-                s.n,
-                own.start,
-                own.end - 1,
-                axis.values.len(),
-                computed.start,
-                out.display()
-            );
-        }
-        return Ok(());
-    }
-    let sw = sweep_model(&sc.model, &axis.name, &axis.values, &a.param, &NEVER)?;
-    write_sweep(&stage, &sc.name, &axis, &xl, &sw)?;
+    let r = study.compute(&NEVER)?;
+    study.write(&stage, &r)?;
     let out = stage.commit()?;
-    report(&sc.name, &axis.name, &sw, &out, a.json)
-}
-
-/// Write `sweep.csv` and the mode-coupling diagram (`sweep.png`/`.svg`) of
-/// `sw` into `stage`. `sweep` and `merge` both write through this, so a
-/// merged sweep is the unsharded one byte for byte.
-pub fn write_sweep(
-    stage: &Staging,
-    name: &str,
-    axis: &Axis,
-    xl: &str,
-    sw: &Sweep,
-) -> Result<(), RunError> {
-    let path = stage.path("sweep.csv");
-    let io = |e: std::io::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
-    let mut w = std::io::BufWriter::new(std::fs::File::create(&path).map_err(io)?);
-    writeln!(w, "{},mode,growth_rate,freq_hz,damping_ratio", axis.name).map_err(io)?;
-    let two_pi = 2.0 * std::f64::consts::PI;
-    for (k, &p) in sw.values.iter().enumerate() {
-        for (m, &b) in sw.listed.iter().enumerate() {
-            let l = sw.lambda[k][b];
-            let mag = l.norm();
-            let zeta = if mag > 0.0 { -l.re / mag } else { 0.0 };
-            writeln!(
-                w,
-                "{},{},{},{},{}",
-                num(p),
-                m + 1,
-                num(l.re),
-                num(l.im.abs() / two_pi),
-                num(zeta)
-            )
-            .map_err(io)?;
+    let (s, own, computed) = match (&r, study.shard) {
+        (SweepResult::Shard { own, computed, .. }, Some(s)) => (s, own, computed),
+        (SweepResult::Whole(sw), _) => {
+            return report(&study.sc.name, &study.param.name, sw, &out, a.json)
         }
-    }
-    w.flush().map_err(io)?;
-    // The mode-coupling diagram.
-    let labels: Vec<String> = (1..=sw.listed.len()).map(|m| format!("mode {m}")).collect();
-    let freq: Vec<Vec<f64>> = sw
-        .listed
-        .iter()
-        .map(|&b| sw.lambda.iter().map(|l| l[b].im.abs() / two_pi).collect())
-        .collect();
-    let sigma: Vec<Vec<f64>> = sw
-        .listed
-        .iter()
-        .map(|&b| sw.lambda.iter().map(|l| l[b].re).collect())
-        .collect();
-    let growing: Vec<Vec<bool>> = sw
-        .listed
-        .iter()
-        .map(|&b| {
-            sw.lambda
-                .iter()
-                .map(|l| squeal_core::stability::is_growing(l[b].re, l[b].im))
-                .collect()
-        })
-        .collect();
-    let branches: Vec<BranchSeries> = (0..sw.listed.len())
-        .map(|m| BranchSeries {
-            label: &labels[m],
-            freq: &freq[m],
-            growth: &sigma[m],
-            growing: &growing[m],
-        })
-        .collect();
-    let marks: Vec<(f64, f64)> = sw
-        .onsets
-        .iter()
-        .filter(|o| o.coalescence)
-        .map(|o| (o.value, o.freq_hz))
-        .collect();
-    let title = format!("{name}: mode-coupling diagram");
-    let spec = ModeCouplingSpec {
-        title: &title,
-        x_label: xl,
-        x: &sw.values,
-        branches: &branches,
-        coalescences: &marks,
+        _ => return Ok(()),
     };
-    squeal_plot::mode_coupling(
-        stage.path("sweep"),
-        &[Format::Png, Format::Svg],
-        squeal_plot::SIZE_MULTI,
-        &spec,
-    )
-    .map_err(|e| RunError::Io(format!("drawing failed: {e}")))?;
+    if a.json {
+        let doc = json!({ "shard": s.k, "shards": s.n, "values": own.len(), "first": own.start, "computed_from": computed.start, "out": out });
+        crate::outln!(
+            "{}",
+            serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
+        );
+    } else {
+        crate::outln!(
+            "{}: shard {}/{} — values {}–{} of {n} (tracked from value {}); output: {} (shard.json, part.json); gather with `squeal merge`",
+            study.sc.name,
+            s.k,
+            s.n,
+            own.start,
+            own.end - 1,
+            computed.start,
+            out.display()
+        );
+    }
     Ok(())
 }
 

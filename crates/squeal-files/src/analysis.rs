@@ -4,11 +4,12 @@
 
 pub use squeal_study::analysis::*;
 
-use crate::run::{Run, RunError};
+use crate::RunError;
 use squeal_plot::{Format, HeatmapSpec, Labels, Panel, Series};
 use squeal_signal::spectrogram;
 use squeal_signal::spectrum::Scaling;
 use squeal_study::model::Channels;
+use squeal_study::run::Run;
 use squeal_study::scenario::InputError;
 use std::fmt::Write as _;
 use std::path::Path;

@@ -1,9 +1,10 @@
 //! Writing a run: `series.csv` (or `series.npy`), `events.csv`, `summary.json`.
 
-use crate::run::{Run, RunError};
+use crate::RunError;
 use serde_json::Value;
 use squeal_core::EventKind;
 use squeal_study::input::{read_regular, read_regular_text, MAX_RECORD_BYTES, MAX_TABLE_BYTES};
+use squeal_study::run::Run;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 

@@ -22,7 +22,7 @@
 //! - SIGINT and SIGTERM remove the staging entries of the running process,
 //!   and the parent folders it created for them, and end it with 130 or 143.
 
-use crate::run::RunError;
+use crate::RunError;
 use serde_json::{json, Value};
 use squeal_study::scenario::InputError;
 use std::path::{Component, Path, PathBuf};
@@ -58,6 +58,18 @@ fn forget(live: &mut Vec<Live>, tmp: &Path) {
 }
 
 /// Remove the folders in `created` (innermost first) that are empty.
+/// Create `parent` (whose missing folders are `created`), removing them
+/// again if that fails, and clear stale staging entries out of it.
+fn make_parent(parent: &Path, created: &[PathBuf]) -> Result<(), RunError> {
+    if let Err(e) = std::fs::create_dir_all(parent) {
+        remove_created(created);
+        let p = parent.display();
+        return Err(RunError::Io(format!("cannot create {p}: {e}")));
+    }
+    clean_stale(parent);
+    Ok(())
+}
+
 fn remove_created(created: &[PathBuf]) {
     for d in created.iter().rev() {
         let _ = std::fs::remove_dir(d);
@@ -134,9 +146,9 @@ pub fn install_signal_handlers() {
             }
             let name = if sig == SIGINT { "SIGINT" } else { "SIGTERM" };
             if live.is_empty() {
-                crate::errln!("interrupted ({name})");
+                note!("interrupted ({name})");
             } else {
-                crate::errln!("interrupted ({name}): partial output removed");
+                note!("interrupted ({name}): partial output removed");
             }
             std::process::exit(128 + sig);
         }
@@ -249,7 +261,7 @@ fn remove_owned(p: &Path) {
             if name_pid.is_some() && marker_pid(p) == name_pid {
                 remove_partial(p);
             } else if std::fs::remove_dir(p).is_err() && p.exists() {
-                crate::errln!(
+                note!(
                     "note: {} is named like a staging folder of squeal's but has no marker of it; left in place",
                     p.display()
                 );
@@ -257,7 +269,7 @@ fn remove_owned(p: &Path) {
             return;
         }
         Err(e) => {
-            crate::errln!("note: {} left in place: {e}", p.display());
+            note!("note: {} left in place: {e}", p.display());
             return;
         }
     };
@@ -276,7 +288,7 @@ fn remove_owned(p: &Path) {
         let _ = std::fs::remove_dir(d);
     }
     if std::fs::remove_dir(p).is_err() && p.exists() {
-        crate::errln!(
+        note!(
             "note: {} holds files squeal did not write; it was left in place",
             p.display()
         );
@@ -537,14 +549,7 @@ impl Staging {
             created: created.clone(),
             done: false,
         };
-        if let Err(e) = std::fs::create_dir_all(parent) {
-            remove_created(&created);
-            return Err(RunError::Io(format!(
-                "cannot create {}: {e}",
-                parent.display()
-            )));
-        }
-        clean_stale(parent);
+        make_parent(parent, &created)?;
         make_stage(&s.tmp, created)?;
         Ok(s)
     }
@@ -694,7 +699,7 @@ pub fn check_file(flag: &str, dest: &Path, force: bool) -> Result<(), RunError> 
             dest,
             format!(
                 "is {}, not a regular file; squeal replaces only regular files, even with --force",
-                file_kind(&m)
+                squeal_study::input::kind_of(m.file_type())
             ),
         )),
         Ok(_) if force => Ok(()),
@@ -712,14 +717,7 @@ impl StagedFile {
         check_file(flag, dest, force)?;
         let parent = parent_of(dest);
         let created = missing_ancestors(parent);
-        if let Err(e) = std::fs::create_dir_all(parent) {
-            remove_created(&created);
-            return Err(RunError::Io(format!(
-                "cannot create {}: {e}",
-                parent.display()
-            )));
-        }
-        clean_stale(parent);
+        make_parent(parent, &created)?;
         let dir = stage_path(dest, "new");
         make_stage(&dir, created.clone())?;
         let tmp = dir.join(dest.file_name().unwrap_or(std::ffi::OsStr::new("file")));
@@ -768,23 +766,6 @@ impl Drop for StagedFile {
             forget(&mut live, &self.dir);
             remove_created(&self.created);
         }
-    }
-}
-
-/// What a file system entry is, in words.
-fn file_kind(m: &std::fs::Metadata) -> &'static str {
-    use std::os::unix::fs::FileTypeExt;
-    let t = m.file_type();
-    if t.is_char_device() {
-        "a character device"
-    } else if t.is_block_device() {
-        "a block device"
-    } else if t.is_fifo() {
-        "a pipe (FIFO)"
-    } else if t.is_socket() {
-        "a socket"
-    } else {
-        "not a regular file"
     }
 }
 
