@@ -44,17 +44,21 @@ __all__ = [
     "inspect",
     "listen",
     "map",
+    "merge",
+    "plot",
     "reduce",
     "reproduce",
     "scenario",
     "scenarios",
     "simulate",
+    "slurm",
     "stability",
     "sweep",
     "validate",
 ]
 
 Scenario = Union[str, "os.PathLike[str]", Mapping[str, Any]]
+PathLike = Union[str, "os.PathLike[str]"]
 Axis = Tuple[str, float, float, int]
 
 
@@ -122,10 +126,11 @@ class Run:
     ``events`` (dict of arrays ``t``, ``kind``, ``contact``), ``summary`` (the
     dict ``summary.json`` holds: verdict, squeal answer, spectra peaks, …),
     ``spectra`` (``{signal: (freq_hz, psd)}``, the Welch spectra behind the
-    summary), ``sample_rate`` (Hz).
+    summary), ``sample_rate`` (Hz), ``out`` (the run folder written, or None).
     """
 
     def __init__(self, raw: Dict[str, Any]) -> None:
+        self.out: Optional[str] = raw.get("out")
         self.columns: List[str] = list(raw["columns"])
         self.data: np.ndarray = raw["data"]
         self.events: Dict[str, np.ndarray] = {
@@ -181,11 +186,55 @@ def simulate(
     scenario: Scenario = "disc-pad",
     *,
     duration: Optional[float] = None,
+    out: Optional[PathLike] = None,
+    formats: Sequence[str] = ("csv",),
+    plots: bool = True,
+    wav: bool = False,
     set: Optional[Mapping[str, Any]] = None,
     **params: Any,
 ) -> Run:
-    """Integrate a scenario (``squeal simulate``): a :class:`Run`."""
-    return Run(_squeal.simulate(*_source(scenario), _sets(set, params), duration))
+    """Integrate a scenario (``squeal simulate``): a :class:`Run`.
+    ``duration`` (s) overrides the scenario's. With ``out``, the CLI's run
+    folder is written there too (``summary.json`` — then the run's
+    ``summary`` is that file's document —, ``events.csv``, ``spectrum.csv``,
+    the series in ``formats`` (``"csv"``, ``"npy"``), the pictures unless
+    ``plots=False`` and with ``wav`` ``squeal.wav``); :func:`plot` redraws
+    it, :func:`listen` renders its sound."""
+    return Run(
+        _squeal.simulate(
+            *_source(scenario), _sets(set, params), duration, _out(out),
+            [str(f) for f in formats], bool(plots), bool(wav),
+        )
+    )
+
+
+def plot(
+    run_dir: PathLike,
+    *,
+    window: str = "hann",
+    segment: int = 16384,
+    overlap: float = 0.5,
+    amplitude: bool = False,
+    signals: Sequence[str] = (),
+    fmax: Optional[float] = None,
+    frange: Optional[Tuple[float, float]] = None,
+    log_f: bool = False,
+) -> List[str]:
+    """Redraw the pictures of a saved run folder (``squeal plot RUN_DIR``)
+    without simulating again: ``window`` (``"hann"``, ``"flattop"``,
+    ``"rect"``), ``segment`` (samples per Welch segment), ``overlap``
+    (0 to 0.95), ``amplitude`` (peak amplitude instead of the PSD),
+    ``signals`` (velocities to analyse; none: all), ``fmax`` or ``frange``
+    (Hz: the band shown), ``log_f`` (logarithmic frequency axes). Only files
+    squeal wrote are replaced; ``spectrum.csv`` and ``summary.json`` say what
+    the new pictures show. Returns the notes the CLI prints on stderr."""
+    fr = None if frange is None else f"{float(frange[0])!r}:{float(frange[1])!r}"
+    return list(
+        _squeal.plot(
+            os.fspath(run_dir), window, int(segment), float(overlap), bool(amplitude),
+            [str(x) for x in signals], fmax, fr, bool(log_f),
+        )
+    )
 
 
 class Stability:
@@ -210,6 +259,7 @@ class Stability:
         self.dofs: List[str] = list(raw["dofs"])
         self.stable: bool = raw["stable"]
         self.neutral: bool = raw["neutral"]
+        self.out: Optional[str] = raw.get("out")
         self._text: str = raw["document"]
         self._doc: Optional[Dict[str, Any]] = None
         k = raw["least_stable"]
@@ -247,13 +297,15 @@ def stability(
     scenario: Scenario = "disc-pad",
     *,
     levers: bool = True,
+    out: Optional[PathLike] = None,
     set: Optional[Mapping[str, Any]] = None,
     **params: Any,
 ) -> Stability:
     """Stability of steady sliding (``squeal stability``): a :class:`Stability`.
     ``levers=False`` skips the search for verdict-flipping parameter changes
-    (hundreds of analyses)."""
-    return Stability(_squeal.stability(*_source(scenario), _sets(set, params), levers))
+    (hundreds of analyses). With ``out``, ``modes.csv`` (every mode's
+    eigenvalue and shape, as ``squeal stability --out``) is written there."""
+    return Stability(_squeal.stability(*_source(scenario), _sets(set, params), levers, _out(out)))
 
 
 def _axis(a: Sequence[Any], what: str) -> Axis:
@@ -274,28 +326,61 @@ def map(
     log_y: bool = False,
     duration: Optional[float] = None,
     threads: Optional[int] = None,
+    shard: Optional[Tuple[int, int]] = None,
+    out: Optional[PathLike] = None,
     set: Optional[Mapping[str, Any]] = None,
     **params: Any,
 ) -> Any:
     """Stability over a grid of two parameters (``squeal map``), in parallel
     and deterministic (any ``threads``: the same bits).
 
+    ``x`` and ``y`` are ``(NAME, LO, HI, N)`` (``LO``, ``HI`` in the
+    parameter's units), spaced logarithmically with ``log_x``/``log_y``;
+    ``duration`` (s) is the simulated time per point with ``transient``.
+
     An ``xarray.Dataset`` with coordinates named after the parameters and
     variables ``max_growth_rate`` (1/s, NaN where steady sliding does not
-    exist) and ``freq_hz``, plus ``outcome``, ``rms_tangential`` (m/s),
-    ``stick_fraction``, ``t_end`` (s), ``agree`` and ``spl_dba`` (dB(A) re
+    exist) and ``freq_hz`` (Hz), plus ``outcome``, ``rms_tangential`` (m/s),
+    ``stick_fraction`` (1), ``t_end`` (s), ``agree`` and ``spl_dba`` (dB(A) re
     20 µPa at the scenario's ``radiation.distance_m``, NaN without radiating
-    surfaces) with ``transient=True``;
-    without xarray a dict of the same names (2-D arrays, y × x, and the two
-    coordinate arrays)."""
+    surfaces) with ``transient=True``; every variable and coordinate has
+    ``units`` and ``long_name``. Without xarray a dict of the same names
+    (2-D arrays, y × x, and the two coordinate arrays).
+
+    ``out``: also write the CLI's files there (``map.csv``, ``map.png``, …;
+    the folder is written beside and swapped in, never over a folder squeal
+    did not write). ``shard=(k, n)``: compute only the points whose flat
+    index ``i`` has ``i mod n = k`` and write them as the CLI's shard
+    (``shard.json`` + ``part.csv``, into ``out`` or ``out/NAME-map-shard-K-of-N``)
+    for :func:`merge`; then the result is the dict ``squeal map --shard
+    --json`` prints: ``shard``, ``shards``, ``points``, ``grid_points``,
+    ``out``."""
     raw = _squeal.stability_map(
         *_source(scenario), _sets(set, params), _axis(x, "x"), _axis(y, "y"),
-        log_x, log_y, transient, duration, threads,
+        log_x, log_y, transient, duration, threads, _shard(shard), _out(out),
     )
+    if shard is not None:
+        return dict(raw)
+    return _map_result(raw)
+
+
+_MAP_META = {
+    "max_growth_rate": ("1/s", "maximum growth rate σ of steady sliding's eigenvalues"),
+    "freq_hz": ("Hz", "frequency of the maximum-growth eigenvalue"),
+    "outcome": ("1", "outcome of the simulated run"),
+    "rms_tangential": ("m/s", "RMS tangential velocity over the judged window"),
+    "stick_fraction": ("1", "fraction of the time a contact sticks"),
+    "t_end": ("s", "time the simulated run ended"),
+    "agree": ("1", "whether the linear verdict and the simulated outcome agree"),
+    "spl_dba": ("dB(A) re 20 µPa", "A-weighted sound pressure level of the last window"),
+}
+
+
+def _map_result(raw: Mapping[str, Any]) -> Any:
+    """A map's Dataset (or dict) from the compiled module's flat arrays."""
     xn, yn = raw["x_name"], raw["y_name"]
     shape = (len(raw["y"]), len(raw["x"]))
-    names = ["max_growth_rate", "freq_hz", "outcome", "rms_tangential", "stick_fraction", "t_end", "agree", "spl_dba"]
-    grids = {k: np.asarray(raw[k]).reshape(shape) for k in names if k in raw}
+    grids = {k: np.asarray(raw[k]).reshape(shape) for k in _MAP_META if k in raw}
     try:
         import xarray as xr
     except ImportError:
@@ -304,12 +389,13 @@ def map(
         {k: ((yn, xn), v) for k, v in grids.items()},
         coords={xn: raw["x"], yn: raw["y"]},
     )
-    ds[xn].attrs["units"] = raw["x_unit"]
-    ds[yn].attrs["units"] = raw["y_unit"]
-    ds["max_growth_rate"].attrs["units"] = "1/s"
-    ds["freq_hz"].attrs["units"] = "Hz"
-    if "spl_dba" in ds:
-        ds["spl_dba"].attrs["units"] = "dB(A) re 20 µPa"
+    ds[xn].attrs.update(units=raw["x_unit"], long_name=f"parameter {xn}")
+    ds[yn].attrs.update(units=raw["y_unit"], long_name=f"parameter {yn}")
+    for k in grids:
+        units, long_name = _MAP_META[k]
+        ds[k].attrs.update(units=units, long_name=long_name)
+    if raw.get("out") is not None:
+        ds.attrs["out"] = raw["out"]
     return ds
 
 
@@ -338,6 +424,8 @@ def sweep(
     scenario: Scenario = "disc-pad",
     *,
     param: Axis,
+    shard: Optional[Tuple[int, int]] = None,
+    out: Optional[PathLike] = None,
     set: Optional[Mapping[str, Any]] = None,
     **params: Any,
 ) -> Any:
@@ -357,8 +445,24 @@ def sweep(
     Without xarray, a dict: ``param``, ``values``, ``eigenvalues`` (values ×
     branches), ``growth_rates``, ``frequencies_hz``, ``listed`` (indices),
     ``onsets`` (list of dicts).
+
+    ``out``: also write the CLI's files there (``sweep.csv``,
+    ``sweep.png``/``.svg``). ``shard=(k, n)``: compute only the k-th of n
+    contiguous slices of the values (and the two values before it, to track
+    the modes across the boundary) and write it as the CLI's shard for
+    :func:`merge`; the result is then ``squeal sweep --shard --json``'s dict
+    (``shard``, ``shards``, ``values``, ``first``, ``computed_from``, ``out``).
     """
-    raw = _squeal.sweep(*_source(scenario), _sets(set, params), _axis(param, "param"))
+    raw = _squeal.sweep(
+        *_source(scenario), _sets(set, params), _axis(param, "param"), _shard(shard), _out(out)
+    )
+    if shard is not None:
+        return dict(raw)
+    return _sweep_result(raw)
+
+
+def _sweep_result(raw: Mapping[str, Any]) -> Any:
+    """A sweep's Dataset (or dict) from the compiled module's arrays."""
     lam = raw["eigenvalues"]
     onsets = json.loads(raw["onsets"])
     try:
@@ -372,6 +476,7 @@ def sweep(
             "frequencies_hz": np.abs(lam.imag) / (2 * np.pi),
             "listed": list(raw["listed"]),
             "onsets": onsets,
+            "out": raw.get("out"),
         }
     name = raw["param"]
     nb = lam.shape[1]
@@ -402,30 +507,171 @@ def sweep(
     }
     for k, (units, long_name) in meta.items():
         ds[k].attrs.update(units=units, long_name=long_name)
+    if raw.get("out") is not None:
+        ds.attrs["out"] = raw["out"]
     return ds
 
 
-def reproduce(*, duration_scale: float = 1.0) -> Dict[str, Any]:
-    """The thesis reproduced (``squeal reproduce`` without its report files):
-    the 40 reconstructed sets run and measured in parallel, the sweeps
-    around set 15 and the seven conclusions graded.
+def reproduce(
+    *,
+    duration_scale: float = 1.0,
+    figures: bool = True,
+    shard: Optional[Tuple[int, int]] = None,
+    out: Optional[PathLike] = None,
+) -> Dict[str, Any]:
+    """The thesis reproduced (``squeal reproduce``): the 40 reconstructed
+    sets run and measured in parallel, the sweeps around set 15 and the
+    seven conclusions graded.
 
     ``table_csv`` (the text of ``table.csv``), ``sets`` (its rows as dicts of
     strings, keyed by its header: ``set``, ``V`` (m/s), ``N`` (N), …,
     ``max_growth_rate`` (1/s), ``squeal_frequency_hz`` (Hz), ``erp_db``,
     ``spl_dba``), ``conclusions`` (``conclusions.json``: ``id``, ``thesis``,
-    ``claim``, ``held``, ``grade``, ``caveat``, ``evidence``, ``data``).
-    ``duration_scale`` scales every set's duration (the CLI's
-    ``--duration-scale``)."""
+    ``claim``, ``held``, ``grade``, ``caveat``, ``evidence``, ``data``) and
+    ``out`` (where the files went, or None). ``duration_scale`` scales every
+    set's duration (the CLI's ``--duration-scale``).
+
+    ``out``: also write the report there (``report.html``, ``report.md``,
+    ``table.csv``, ``conclusions.json``, the V × N map and, with
+    ``figures``, each set's Appendix A pictures). ``shard=(k, n)``: measure
+    only the sets whose index ``i`` (set ``i + 1``) has ``i mod n = k`` and
+    write them as the CLI's shard for :func:`merge` (into ``out`` or
+    ``out/reproduce-shard-K-of-N``); ``sets`` then holds those sets only and
+    ``conclusions`` is empty (they need all 40)."""
+    table, conclusions, dest = _squeal.reproduce(
+        float(duration_scale), bool(figures), _shard(shard), _out(out)
+    )
+    return _reproduce_result(table, conclusions, dest)
+
+
+def _reproduce_result(table: str, conclusions: str, dest: Optional[str]) -> Dict[str, Any]:
     import csv
     import io
 
-    table, conclusions = _squeal.reproduce(float(duration_scale))
     return {
         "table_csv": table,
         "sets": list(csv.DictReader(io.StringIO(table))),
         "conclusions": json.loads(conclusions),
+        "out": dest,
     }
+
+
+def merge(paths: Sequence[PathLike], *, out: PathLike) -> Any:
+    """Gather the shards of one study (``squeal merge DIR… --out DIR``):
+    every shard folder of a map, a sweep or ``reproduce``, in any order,
+    checked to belong together and to be complete (:class:`ScenarioError`
+    names a missing shard's points, a shard given twice, a changed file),
+    written into ``out`` as the unsharded study's files, byte for byte.
+    Returns what the unsharded study returns: :func:`map`'s Dataset,
+    :func:`sweep`'s Dataset or :func:`reproduce`'s dict."""
+    kind, raw = _squeal.merge([os.fspath(p) for p in paths], os.fspath(out))
+    if kind == "map":
+        return _map_result(raw)
+    if kind == "sweep":
+        return _sweep_result(raw)
+    return _reproduce_result(raw["table"], raw["conclusions"], raw["out"])
+
+
+def slurm(
+    study: str,
+    scenario: Scenario = "disc-pad",
+    *,
+    tasks: int,
+    x: Optional[Axis] = None,
+    y: Optional[Axis] = None,
+    log_x: bool = False,
+    log_y: bool = False,
+    transient: bool = False,
+    duration: Optional[float] = None,
+    param: Optional[Axis] = None,
+    duration_scale: float = 1.0,
+    figures: bool = True,
+    out: Optional[PathLike] = None,
+    jobs: Optional[PathLike] = None,
+    partition: Optional[str] = None,
+    time: Optional[str] = None,
+    cpus_per_task: Optional[int] = None,
+    submit: bool = False,
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
+) -> Dict[str, Any]:
+    """A study as a SLURM job array (``squeal slurm map|sweep|reproduce``):
+    ``study`` is ``"map"`` (with ``x``, ``y`` and :func:`map`'s options),
+    ``"sweep"`` (with ``param``) or ``"reproduce"`` (``duration_scale``,
+    ``figures``); ``tasks`` shards, each an array task running this Python's
+    squeal (``python -m squeal STUDY … --shard K/N``), and a merge job after
+    them that writes the whole study into ``out`` (default the CLI's
+    ``out/NAME-map``, ``out/NAME-sweep`` or ``out/reproduce``).
+
+    The scripts ``array.sh`` and ``merge.sh`` go into ``jobs`` (default
+    ``OUT-slurm``) with the scenario when it is a dict (``scenario.json``);
+    ``partition``, ``time`` (SLURM's format, e.g. ``"2:00:00"``) and
+    ``cpus_per_task`` become ``#SBATCH`` lines (squeal's threads follow
+    ``SLURM_CPUS_PER_TASK``). With ``submit``, ``sbatch`` submits both.
+    Returns ``jobs``, ``array``, ``merge``, ``out``, ``submit_line`` (the
+    command that submits them by hand), ``rerun_line`` and, when submitted,
+    ``array_job`` and ``merge_job`` (SLURM's job ids)."""
+    import sys
+
+    kind, text = _source(scenario)
+    sets = _sets(set, params)
+    extra: List[Tuple[str, str]] = []
+    if kind == "json":
+        extra.append(("scenario.json", text + "\n"))
+    args = [study]
+    if study in ("map", "sweep"):
+        if kind == "json":
+            # The tasks read the dict back from the jobs folder.
+            args.append("@scenario.json")
+        else:
+            args.append(os.path.abspath(text) if os.path.exists(text) else text)
+        for s_ in sets:
+            args += ["--set", s_]
+    if study == "map":
+        if x is None or y is None:
+            raise ScenarioError("slurm map: needs x and y, as (NAME, LO, HI, N)")
+        args += ["--x", _axis_text(_axis(x, "x")), "--y", _axis_text(_axis(y, "y"))]
+        args += ["--log-x"] * bool(log_x) + ["--log-y"] * bool(log_y)
+        args += ["--transient"] * bool(transient)
+        if duration is not None:
+            args += ["--duration", repr(float(duration))]
+    elif study == "sweep":
+        if param is None:
+            raise ScenarioError("slurm sweep: needs param, as (NAME, LO, HI, N)")
+        args += ["--param", _axis_text(_axis(param, "param"))]
+    elif study == "reproduce":
+        args += ["--duration-scale", repr(float(duration_scale))]
+        args += ["--no-figures"] * (not figures)
+    return dict(
+        _squeal.slurm(
+            study, kind, text, sets, [sys.executable, "-m", "squeal"], args, int(tasks),
+            _axis(x, "x") if x is not None else None,
+            _axis(y, "y") if y is not None else None,
+            bool(log_x), bool(log_y), bool(transient), duration,
+            _axis(param, "param") if param is not None else None,
+            float(duration_scale), _out(out), partition, time, cpus_per_task,
+            _out(jobs), bool(submit), extra,
+        )
+    )
+
+
+def _axis_text(a: Axis) -> str:
+    """``(NAME, LO, HI, N)`` as the CLI's ``NAME=LO:HI:N`` (floats round-trip)."""
+    return f"{a[0]}={a[1]!r}:{a[2]!r}:{a[3]}"
+
+
+def _shard(shard: Optional[Sequence[int]]) -> Optional[Tuple[int, int]]:
+    if shard is None:
+        return None
+    try:
+        k, n = shard
+        return (int(k), int(n))
+    except (TypeError, ValueError):
+        raise ScenarioError(f"shard {shard!r}: expected (K, N), K counting from 0") from None
+
+
+def _out(out: Optional[PathLike]) -> Optional[str]:
+    return None if out is None else os.fspath(out)
 
 
 def validate(filter: Optional[str] = None) -> Dict[str, Any]:
@@ -583,6 +829,7 @@ def cycle(
     settle_steps: int = 20_000_000,
     settle_time: float = 1000.0,
     settle_tol: float = 1e-2,
+    out: Optional[PathLike] = None,
     set: Optional[Mapping[str, Any]] = None,
     **params: Any,
 ) -> Dict[str, Any]:
@@ -591,7 +838,10 @@ def cycle(
     ``stable``, ``amplitude``, ``events_per_period``, the shooting residual,
     …) plus ``orbit`` (one period, rows × ``orbit_columns``, float64) and
     ``orbit_events`` (the event kind on each row, "" for none).
-    ``section`` is ``"STATE"`` or ``"STATE=LEVEL"`` as ``--section``."""
+    ``section`` is ``"STATE"`` or ``"STATE=LEVEL"`` as ``--section``;
+    ``settle_time`` is in s. With ``out``, the CLI's files (``orbit.csv``,
+    ``summary.json``, the pictures) are written there and ``out`` says where.
+    """
     raw = _squeal.cycle(
         *_source(scenario),
         _sets(set, params),
@@ -599,8 +849,11 @@ def cycle(
         float(settle_time),
         float(settle_tol),
         section,
+        _out(out),
     )
     doc: Dict[str, Any] = json.loads(raw["document"])
+    if raw["out"] is not None:
+        doc["out"] = raw["out"]
     if "orbit" in raw:
         doc["orbit_columns"] = list(raw["orbit_columns"])
         doc["orbit"] = raw["orbit"]
@@ -616,6 +869,7 @@ def hb(
     settle_steps: int = 20_000_000,
     settle_time: float = 1000.0,
     settle_tol: float = 1e-2,
+    out: Optional[PathLike] = None,
     set: Optional[Mapping[str, Any]] = None,
     **params: Any,
 ) -> Dict[str, Any]:
@@ -632,7 +886,9 @@ def hb(
     is H (1…400); ``guess`` is ``"settle"`` (a settled simulation, as
     ``cycle``) or ``"hopf"`` (steady sliding's growing mode, no simulation,
     settling only if that finds no stable orbit); the settling options are
-    ``cycle``'s. Orbits that stick raise ``ScenarioError``."""
+    ``cycle``'s. Orbits that stick raise ``ScenarioError``. With ``out``,
+    the CLI's files (``hb_orbit.csv``, ``summary.json``, ``hb.png``) are
+    written there."""
     return dict(
         json.loads(
             _squeal.hb(
@@ -643,6 +899,7 @@ def hb(
                 float(settle_time),
                 float(settle_tol),
                 str(guess),
+                _out(out),
             )
         )
     )
@@ -652,11 +909,18 @@ def branch(
     scenario: Scenario = "disc-pad",
     *,
     param: Axis,
+    out: Optional[PathLike] = None,
     set: Optional[Mapping[str, Any]] = None,
     **params: Any,
 ) -> Dict[str, Any]:
     """Continuation of the limit cycle over one parameter
     (``squeal branch --json``): the CLI's document (``points`` with period,
     amplitudes, multipliers and stability; ``bifurcations``; ``segments``;
-    ``hopf``). ``param`` is ``(NAME, LO, HI, N)`` as ``--param``."""
-    return dict(json.loads(_squeal.branch(*_source(scenario), _sets(set, params), _axis(param, "param"))))
+    ``hopf``). ``param`` is ``(NAME, LO, HI, N)`` as ``--param``. With
+    ``out``, the CLI's files (``branch.csv``, ``summary.json``, the
+    bifurcation diagram ``branch.png``) are written there."""
+    return dict(
+        json.loads(
+            _squeal.branch(*_source(scenario), _sets(set, params), _axis(param, "param"), _out(out))
+        )
+    )

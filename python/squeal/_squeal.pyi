@@ -17,8 +17,28 @@ class ScenarioError(ValueError):
 
 def scenarios() -> List[str]: ...
 def scenario_doc(kind: str, text: str, sets: List[str]) -> Tuple[str, str]: ...
-def simulate(kind: str, text: str, sets: List[str], duration: Optional[float] = None) -> Dict[str, Any]: ...
-def stability(kind: str, text: str, sets: List[str], levers: bool) -> Dict[str, Any]: ...
+def simulate(
+    kind: str,
+    text: str,
+    sets: List[str],
+    duration: Optional[float] = None,
+    out: Optional[str] = None,
+    formats: List[str] = ...,
+    plots: bool = True,
+    wav: bool = False,
+) -> Dict[str, Any]: ...
+def plot(
+    run_dir: str,
+    window: str = "hann",
+    segment: int = ...,
+    overlap: float = 0.5,
+    amplitude: bool = False,
+    signals: List[str] = ...,
+    fmax: Optional[float] = None,
+    frange: Optional[str] = None,
+    log_f: bool = False,
+) -> List[str]: ...
+def stability(kind: str, text: str, sets: List[str], levers: bool, out: Optional[str] = None) -> Dict[str, Any]: ...
 def stability_map(
     kind: str,
     text: str,
@@ -30,11 +50,20 @@ def stability_map(
     transient: bool,
     duration: Optional[float] = None,
     threads: Optional[int] = None,
+    shard: Optional[Tuple[int, int]] = None,
+    out: Optional[str] = None,
 ) -> Dict[str, Any]: ...
 def critical(
     kind: str, text: str, sets: List[str], name: str, lo: float, hi: float, grid: int
 ) -> str: ...
-def sweep(kind: str, text: str, sets: List[str], param: Tuple[str, float, float, int]) -> Dict[str, Any]: ...
+def sweep(
+    kind: str,
+    text: str,
+    sets: List[str],
+    param: Tuple[str, float, float, int],
+    shard: Optional[Tuple[int, int]] = None,
+    out: Optional[str] = None,
+) -> Dict[str, Any]: ...
 def cycle(
     kind: str,
     text: str,
@@ -43,8 +72,11 @@ def cycle(
     settle_time: float,
     settle_tol: float,
     section: Optional[str] = None,
+    out: Optional[str] = None,
 ) -> Dict[str, Any]: ...
-def branch(kind: str, text: str, sets: List[str], param: Tuple[str, float, float, int]) -> str: ...
+def branch(
+    kind: str, text: str, sets: List[str], param: Tuple[str, float, float, int], out: Optional[str] = None
+) -> str: ...
 def hb(
     kind: str,
     text: str,
@@ -54,6 +86,7 @@ def hb(
     settle_time: float,
     settle_tol: float,
     guess: str,
+    out: Optional[str] = None,
 ) -> str: ...
 def validate(filter: Optional[str] = None) -> str: ...
 def inspect(kind: str, text: str, sets: List[str]) -> str: ...
@@ -69,4 +102,34 @@ def listen(
     float: bool,
     file_name: str,
 ) -> Dict[str, Any]: ...
-def reproduce(duration_scale: float = 1.0) -> Tuple[str, str]: ...
+def reproduce(
+    duration_scale: float = 1.0,
+    figures: bool = True,
+    shard: Optional[Tuple[int, int]] = None,
+    out: Optional[str] = None,
+) -> Tuple[str, str, Optional[str]]: ...
+def merge(dirs: List[str], out: str) -> Tuple[str, Dict[str, Any]]: ...
+def slurm(
+    study: str,
+    kind: str,
+    text: str,
+    sets: List[str],
+    program: List[str],
+    args: List[str],
+    tasks: int,
+    x: Optional[Tuple[str, float, float, int]] = None,
+    y: Optional[Tuple[str, float, float, int]] = None,
+    log_x: bool = False,
+    log_y: bool = False,
+    transient: bool = False,
+    duration: Optional[float] = None,
+    param: Optional[Tuple[str, float, float, int]] = None,
+    duration_scale: float = 1.0,
+    out: Optional[str] = None,
+    partition: Optional[str] = None,
+    time: Optional[str] = None,
+    cpus_per_task: Optional[int] = None,
+    jobs: Optional[str] = None,
+    submit: bool = False,
+    extra: List[Tuple[str, str]] = ...,
+) -> Dict[str, Any]: ...

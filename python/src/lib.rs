@@ -15,10 +15,14 @@ use pyo3::create_exception;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use squeal_files::map::MapStudy;
+use squeal_files::shard::Shard;
+use squeal_files::Staging;
 use squeal_study::map::{self, Axis};
 use squeal_study::scenario::{self, Source};
 use squeal_study::{Cancel, NoProgress, Scenario, StudyError};
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::Path;
 use std::sync::{Condvar, Mutex, PoisonError};
 use std::time::Duration;
 
@@ -42,6 +46,17 @@ fn study_err(e: StudyError) -> PyErr {
     match e {
         StudyError::Input(i) => ScenarioError::new_err(i.0),
         StudyError::Interrupted => PyKeyboardInterrupt::new_err("interrupted"),
+        other => SquealError::new_err(other.to_string()),
+    }
+}
+
+/// A files-layer error as Python's: bad input → ScenarioError, an
+/// interruption → KeyboardInterrupt, the rest → SquealError.
+fn run_err(e: squeal_files::RunError) -> PyErr {
+    use squeal_files::RunError;
+    match e {
+        RunError::Input(i) => ScenarioError::new_err(i.0),
+        RunError::Interrupted => PyKeyboardInterrupt::new_err("interrupted"),
         other => SquealError::new_err(other.to_string()),
     }
 }
@@ -79,6 +94,16 @@ where
     T: Send,
     F: FnOnce(&Cancel) -> Result<T, StudyError> + Send,
 {
+    compute_with(py, work, study_err)
+}
+
+/// [`compute`] for work whose error is `E`, turned into Python's by `to_py`.
+fn compute_with<T, E, F>(py: Python<'_>, work: F, to_py: fn(E) -> PyErr) -> PyResult<T>
+where
+    T: Send,
+    E: Send,
+    F: FnOnce(&Cancel) -> Result<T, E> + Send,
+{
     let cancel = Cancel::new();
     // Set by the worker when it is done; the caller waits on it in slices of POLL.
     let done = (Mutex::new(false), Condvar::new());
@@ -111,7 +136,7 @@ where
             }
         }
         match py.allow_threads(|| worker.join()) {
-            Ok(Ok(r)) => r.map_err(study_err),
+            Ok(Ok(r)) => r.map_err(to_py),
             Ok(Err(panic)) | Err(panic) => Err(panic_err(panic)),
         }
     })
@@ -170,17 +195,33 @@ fn scenario_doc(kind: &str, text: &str, sets: Vec<String>) -> PyResult<(String, 
 /// order: each column contiguous), the events, the summary (JSON text) and
 /// the spectra of the analysed velocities.
 #[pyfunction]
-#[pyo3(signature = (kind, text, sets, duration=None))]
+#[pyo3(signature = (kind, text, sets, duration=None, out=None, formats=vec!["csv".to_string()], plots=true, wav=false))]
+#[allow(clippy::too_many_arguments)]
 fn simulate<'py>(
     py: Python<'py>,
     kind: &str,
     text: &str,
     sets: Vec<String>,
     duration: Option<f64>,
+    out: Option<String>,
+    formats: Vec<String>,
+    plots: bool,
+    wav: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let sc = with_source(kind, text, |s| {
         squeal_study::feasible::resolve_run(s, &sets, duration)
     })?;
+    for f in &formats {
+        if f != "csv" && f != "npy" {
+            return Err(ScenarioError::new_err(format!(
+                "formats {f:?}: expected \"csv\" or \"npy\""
+            )));
+        }
+    }
+    let stage = out
+        .as_deref()
+        .map(|o| stage_for(Some(o), &sc.name))
+        .transpose()?;
     let (run, summary, spectra) = compute(py, |cancel| {
         let start = std::time::Instant::now();
         let mut run = squeal_study::run::run(&sc, &NoProgress, cancel)?;
@@ -201,6 +242,34 @@ fn simulate<'py>(
             .collect();
         Ok((run, summary, spectra))
     })?;
+    let mut summary = summary;
+    let mut dest = None;
+    if let Some(stage) = stage {
+        use squeal_files::analysis::{PlotSettings, SpectrumSettings};
+        let t0 = std::time::Instant::now();
+        let spectrum = SpectrumSettings::default();
+        let plot = PlotSettings::default();
+        let files = squeal_files::run_dir::RunFiles {
+            csv: formats.iter().any(|f| f == "csv"),
+            npy: formats.iter().any(|f| f == "npy"),
+            plots,
+            wav,
+            spectrum: &spectrum,
+            plot: &plot,
+            signals: &[],
+        };
+        let write = || -> Result<serde_json::Value, squeal_files::RunError> {
+            let w = squeal_files::run_dir::write_run(&stage, &sc, &run, &files)?;
+            let mut summary = w.summary;
+            let output_s = t0.elapsed().as_secs_f64();
+            summary["timing"] =
+                serde_json::json!({ "integrate_s": run.integrate_s, "output_s": output_s });
+            squeal_files::output::write_json(&summary, &stage.path("summary.json"))?;
+            Ok(summary)
+        };
+        summary = py.allow_threads(write).map_err(run_err)?;
+        dest = Some(commit(py, stage)?);
+    }
     let (rows, cols) = (run.len(), run.columns.len());
     let mut flat = Vec::with_capacity(rows * cols);
     for c in &run.data {
@@ -229,19 +298,50 @@ fn simulate<'py>(
         sp.set_item(name, (f.into_pyarray(py), p.into_pyarray(py)))?;
     }
     out.set_item("spectra", sp)?;
+    out.set_item("out", dest)?;
     Ok(out)
 }
 
-/// Stability of steady sliding: a dict of arrays and the JSON document.
+/// Redraw the pictures of a saved run folder (`squeal plot RUN_DIR`) with
+/// these spectrum and picture settings; returns the notes the CLI prints.
 #[pyfunction]
+#[pyo3(signature = (run_dir, window="hann", segment=squeal_study::analysis::SEGMENT, overlap=0.5, amplitude=false, signals=Vec::new(), fmax=None, frange=None, log_f=false))]
+#[allow(clippy::too_many_arguments)]
+fn plot(
+    py: Python<'_>,
+    run_dir: String,
+    window: &str,
+    segment: usize,
+    overlap: f64,
+    amplitude: bool,
+    signals: Vec<String>,
+    fmax: Option<f64>,
+    frange: Option<String>,
+    log_f: bool,
+) -> PyResult<Vec<String>> {
+    use squeal_files::analysis::{PlotSettings, SpectrumSettings};
+    let settings =
+        SpectrumSettings::from_flags(window, segment, overlap, amplitude).map_err(input_err)?;
+    let plot = PlotSettings::from_flags(fmax, frange.as_deref(), log_f).map_err(input_err)?;
+    let dir = Path::new(&run_dir);
+    py.allow_threads(|| squeal_files::run_dir::redraw(dir, &settings, &plot, &signals))
+        .map_err(run_err)
+}
+
+/// Stability of steady sliding: a dict of arrays and the JSON document;
+/// with `out`, `modes.csv` written there (`stability --out`).
+#[pyfunction]
+#[pyo3(signature = (kind, text, sets, levers, out=None))]
 fn stability<'py>(
     py: Python<'py>,
     kind: &str,
     text: &str,
     sets: Vec<String>,
     levers: bool,
+    out: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let sc = resolve(kind, text, &sets)?;
+    let stage = out.as_deref().map(new_stage).transpose()?;
     // Without levers the analysis takes microseconds: no worker thread.
     let work = |cancel: &Cancel| {
         let an = squeal_study::stability::analyse(&sc.model)
@@ -257,6 +357,15 @@ fn stability<'py>(
         compute(py, work)?
     } else {
         compute_quick(py, work)?
+    };
+    let dest = match stage {
+        Some(stage) => {
+            let path = stage.path("modes.csv");
+            let write = || squeal_files::modes::write_modes_csv(&path, &sc.model, &an);
+            py.allow_threads(write).map_err(run_err)?;
+            Some(commit(py, stage)?)
+        }
+        None => None,
     };
     let n2 = an.eigen.len();
     let eig: Vec<Complex64> = an
@@ -306,6 +415,7 @@ fn stability<'py>(
         "document",
         json_text(&squeal_study::stability::document(&sc, &an, &lev))?,
     )?;
+    out.set_item("out", dest)?;
     Ok(out)
 }
 
@@ -314,10 +424,66 @@ fn axis(spec: (String, f64, f64, usize), flag: &str, log: bool, sc: &Scenario) -
     map::parse_axis(&text, flag, log, &sc.model).map_err(input_err)
 }
 
+/// An axis as Python gives it: (NAME, LO, HI, N).
+type AxisSpec = (String, f64, f64, usize);
+
+/// A map's scenario (checked for simulation with `transient` or a
+/// `duration`, as `simulate` checks it) and both axes, checked.
+fn map_inputs(
+    kind: &str,
+    text: &str,
+    sets: &[String],
+    (x, y): (AxisSpec, AxisSpec),
+    (log_x, log_y): (bool, bool),
+    transient: bool,
+    duration: Option<f64>,
+) -> PyResult<(Scenario, Axis, Axis)> {
+    let sc = if transient || duration.is_some() {
+        with_source(kind, text, |s| {
+            squeal_study::feasible::resolve_run(s, sets, duration)
+        })?
+    } else {
+        resolve(kind, text, sets)?
+    };
+    let xa = axis(x, "--x", log_x, &sc)?;
+    let ya = axis(y, "--y", log_y, &sc)?;
+    map::check_distinct(&xa, &ya).map_err(input_err)?;
+    Ok((sc, xa, ya))
+}
+
+/// A `shard=(k, n)` checked as the CLI checks `--shard K/N`.
+fn shard_of(shard: Option<(usize, usize)>) -> PyResult<Option<Shard>> {
+    shard
+        .map(|(k, n)| {
+            Shard::parse(&format!("{k}/{n}"))
+                .map_err(|e| ScenarioError::new_err(e.0.replacen("--shard", "shard", 1)))
+        })
+        .transpose()
+}
+
+/// The staged output folder `out` (or the CLI's default `out/<folder>` for
+/// a shard without one), checked before any work.
+fn stage_for(out: Option<&str>, folder: &str) -> PyResult<Staging> {
+    Staging::for_out(out.map(Path::new), folder).map_err(run_err)
+}
+
+/// The staged output folder `out` (`cycle`, `hb`, `branch`: no default).
+fn new_stage(out: &str) -> PyResult<Staging> {
+    Staging::new(Path::new(out)).map_err(run_err)
+}
+
+fn commit(py: Python<'_>, stage: Staging) -> PyResult<String> {
+    let dest = py.allow_threads(|| stage.commit()).map_err(run_err)?;
+    Ok(dest.to_string_lossy().into_owned())
+}
+
 /// A stability map (and the transient outcome when asked): a dict of the
 /// axes and flat row-major (y then x) arrays, in the CLI's point order.
+/// With `out`, its files are written there too (`map --out`); with
+/// `shard`, only the shard's points are computed and written as the CLI's
+/// shard (`shard.json` + `part.csv`), and the dict is `map --shard --json`'s.
 #[pyfunction]
-#[pyo3(signature = (kind, text, sets, x, y, log_x, log_y, transient, duration=None, threads=None))]
+#[pyo3(signature = (kind, text, sets, x, y, log_x, log_y, transient, duration=None, threads=None, shard=None, out=None))]
 fn stability_map<'py>(
     py: Python<'py>,
     kind: &str,
@@ -330,17 +496,18 @@ fn stability_map<'py>(
     transient: bool,
     duration: Option<f64>,
     threads: Option<usize>,
+    shard: Option<(usize, usize)>,
+    out: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let sc = if transient || duration.is_some() {
-        with_source(kind, text, |s| {
-            squeal_study::feasible::resolve_run(s, &sets, duration)
-        })?
-    } else {
-        resolve(kind, text, &sets)?
-    };
-    let xa = axis(x, "--x", log_x, &sc)?;
-    let ya = axis(y, "--y", log_y, &sc)?;
-    map::check_distinct(&xa, &ya).map_err(input_err)?;
+    let (sc, xa, ya) = map_inputs(
+        kind,
+        text,
+        &sets,
+        (x, y),
+        (log_x, log_y),
+        transient,
+        duration,
+    )?;
     let pool = match threads {
         Some(0) => return Err(ScenarioError::new_err("threads 0: must be at least 1")),
         Some(n) => Some(
@@ -351,78 +518,79 @@ fn stability_map<'py>(
         ),
         None => None,
     };
-    let (lin, trans) = compute(py, |cancel| {
-        let work = || {
-            let points = map::all_points(&xa, &ya);
-            let lin = map::linear_grid(&sc.model, &xa, &ya, &points, &NoProgress, cancel)?;
-            let trans = if transient {
-                Some(map::transient_grid(
-                    &sc,
-                    &xa,
-                    &ya,
-                    &points,
-                    &NoProgress,
-                    cancel,
-                )?)
-            } else {
-                None
-            };
-            Ok((lin, trans))
-        };
+    let study = MapStudy {
+        sc,
+        x: xa,
+        y: ya,
+        transient,
+        shard: shard_of(shard)?,
+    };
+    let files = out.is_some() || study.shard.is_some();
+    let stage = files
+        .then(|| stage_for(out.as_deref(), &study.folder()))
+        .transpose()?;
+    let r = compute(py, |cancel| {
+        let work = || study.compute(&|_, _| Box::new(NoProgress), cancel);
         match &pool {
             Some(p) => p.install(work),
             None => work(),
         }
     })?;
+    let dest = match stage {
+        Some(stage) => {
+            py.allow_threads(|| study.write(&stage, &r))
+                .map_err(run_err)?;
+            Some(commit(py, stage)?)
+        }
+        None => None,
+    };
+    if let Some(s) = study.shard {
+        let d = PyDict::new(py);
+        d.set_item("shard", s.k)?;
+        d.set_item("shards", s.n)?;
+        d.set_item("points", r.points.len())?;
+        d.set_item("grid_points", study.grid_points())?;
+        d.set_item("out", dest)?;
+        return Ok(d);
+    }
+    let (m, xa, ya) = (&study.sc.model, &study.x, &study.y);
+    let units = (map::unit_of(m, &xa.name), map::unit_of(m, &ya.name));
+    let d = map_dict(py, xa, ya, units, &r.lin, r.trans.as_deref())?;
+    d.set_item("out", dest)?;
+    Ok(d)
+}
+
+/// A map's dict (see [`stability_map`]) from its axes, their units and
+/// every point's results in flat order.
+fn map_dict<'py>(
+    py: Python<'py>,
+    xa: &Axis,
+    ya: &Axis,
+    units: (&str, &str),
+    lin: &[(f64, f64)],
+    trans: Option<&[map::Outcome]>,
+) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
     out.set_item("x_name", &xa.name)?;
     out.set_item("y_name", &ya.name)?;
-    out.set_item("x_unit", map::unit_of(&sc.model, &xa.name))?;
-    out.set_item("y_unit", map::unit_of(&sc.model, &ya.name))?;
+    out.set_item("x_unit", units.0)?;
+    out.set_item("y_unit", units.1)?;
     out.set_item("x", xa.values.clone().into_pyarray(py))?;
     out.set_item("y", ya.values.clone().into_pyarray(py))?;
-    out.set_item(
-        "max_growth_rate",
-        lin.iter().map(|p| p.0).collect::<Vec<_>>().into_pyarray(py),
-    )?;
-    out.set_item(
-        "freq_hz",
-        lin.iter().map(|p| p.1).collect::<Vec<_>>().into_pyarray(py),
-    )?;
+    let col = |f: &dyn Fn(usize) -> f64| (0..lin.len()).map(f).collect::<Vec<f64>>();
+    out.set_item("max_growth_rate", col(&|i| lin[i].0).into_pyarray(py))?;
+    out.set_item("freq_hz", col(&|i| lin[i].1).into_pyarray(py))?;
     if let Some(t) = trans {
         out.set_item("outcome", t.iter().map(|o| o.class).collect::<Vec<_>>())?;
-        out.set_item(
-            "rms_tangential",
-            t.iter().map(|o| o.rms).collect::<Vec<_>>().into_pyarray(py),
-        )?;
+        out.set_item("rms_tangential", col(&|i| t[i].rms).into_pyarray(py))?;
         out.set_item(
             "stick_fraction",
-            t.iter()
-                .map(|o| o.stick_fraction)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
+            col(&|i| t[i].stick_fraction).into_pyarray(py),
         )?;
-        out.set_item(
-            "t_end",
-            t.iter()
-                .map(|o| o.t_end)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
-        )?;
-        out.set_item(
-            "spl_dba",
-            t.iter()
-                .map(|o| o.spl_dba)
-                .collect::<Vec<_>>()
-                .into_pyarray(py),
-        )?;
-        out.set_item(
-            "agree",
-            t.iter()
-                .zip(&lin)
-                .map(|(o, (s, _))| map::agree(*s, o))
-                .collect::<Vec<_>>(),
-        )?;
+        out.set_item("t_end", col(&|i| t[i].t_end).into_pyarray(py))?;
+        out.set_item("spl_dba", col(&|i| t[i].spl_dba).into_pyarray(py))?;
+        let agree = t.iter().zip(lin).map(|(o, (s, _))| map::agree(*s, o));
+        out.set_item("agree", agree.collect::<Vec<_>>())?;
     }
     Ok(out)
 }
@@ -456,43 +624,131 @@ fn critical(
 }
 
 /// An eigenvalue sweep: values, the eigenvalues (values × branches) and the
-/// indices of the listed branches.
+/// indices of the listed branches. With `out`, its files are written there
+/// too; with `shard`, only the shard's slice is computed and written as the
+/// CLI's shard, and the dict is `sweep --shard --json`'s.
 #[pyfunction]
+#[pyo3(signature = (kind, text, sets, param, shard=None, out=None))]
 fn sweep<'py>(
     py: Python<'py>,
     kind: &str,
     text: &str,
     sets: Vec<String>,
     param: (String, f64, f64, usize),
+    shard: Option<(usize, usize)>,
+    out: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    use squeal_files::sweep::{SweepResult, SweepStudy};
     let sc = resolve(kind, text, &sets)?;
     let spec = format!("{}={}:{}:{}", param.0, param.1, param.2, param.3);
     let ax = map::parse_axis(&spec, "--param", false, &sc.model).map_err(input_err)?;
-    let sw = compute(py, |cancel| {
-        squeal_study::sweep::sweep_model(&sc.model, &ax.name, &ax.values, &spec, cancel)
-    })?;
+    let study = SweepStudy::new(sc, ax, &spec, shard_of(shard)?).map_err(input_err)?;
+    let files = out.is_some() || study.shard.is_some();
+    let stage = files
+        .then(|| stage_for(out.as_deref(), &study.folder()))
+        .transpose()?;
+    let r = compute(py, |cancel| study.compute(cancel))?;
+    let dest = match stage {
+        Some(stage) => {
+            py.allow_threads(|| study.write(&stage, &r))
+                .map_err(run_err)?;
+            Some(commit(py, stage)?)
+        }
+        None => None,
+    };
+    match (&r, study.shard) {
+        (SweepResult::Shard { own, computed, .. }, Some(s)) => {
+            let d = PyDict::new(py);
+            d.set_item("shard", s.k)?;
+            d.set_item("shards", s.n)?;
+            d.set_item("values", own.len())?;
+            d.set_item("first", own.start)?;
+            d.set_item("computed_from", computed.start)?;
+            d.set_item("out", dest)?;
+            Ok(d)
+        }
+        (SweepResult::Whole(sw), _) => {
+            let unit = map::unit_of(&study.sc.model, &study.param.name);
+            let d = sweep_dict(py, &study.param.name, unit, sw)?;
+            d.set_item("out", dest)?;
+            Ok(d)
+        }
+        _ => Err(SquealError::new_err("a sweep's shard without its shard")),
+    }
+}
+
+/// A sweep's dict (see [`sweep`]).
+fn sweep_dict<'py>(
+    py: Python<'py>,
+    name: &str,
+    unit: &str,
+    sw: &squeal_core::stability::sweep::Sweep,
+) -> PyResult<Bound<'py, PyDict>> {
     let k = sw.values.len();
     let b = sw.lambda.first().map_or(0, Vec::len);
     let lambda = Array2::from_shape_vec((k, b), sw.lambda.concat())
         .map_err(|e| SquealError::new_err(e.to_string()))?;
     let out = PyDict::new(py);
-    out.set_item("param", &ax.name)?;
+    out.set_item("param", name)?;
     out.set_item("values", sw.values.clone().into_pyarray(py))?;
     out.set_item("eigenvalues", lambda.into_pyarray(py))?;
     out.set_item("listed", sw.listed.clone())?;
-    out.set_item("unit", map::unit_of(&sc.model, &ax.name))?;
+    out.set_item("unit", unit)?;
     out.set_item("onsets", json_text(&serde_json::json!(sw.onsets))?)?;
     Ok(out)
 }
 
-/// The thesis reproduced (`squeal reproduce`'s content without its files):
-/// `table.csv`'s text and `conclusions.json`'s document as JSON text.
+/// The thesis reproduced: `table.csv`'s text and `conclusions.json`'s
+/// document as JSON text, and where its files went (None without `out` or
+/// `shard`). With `out`, the whole report is written there (`reproduce
+/// --out`, pictures with `figures`); with `shard`, only the shard's sets
+/// are measured and written as the CLI's shard (their table rows are
+/// returned; no conclusions, which need all 40: an empty list).
 #[pyfunction]
-#[pyo3(signature = (duration_scale=1.0))]
-fn reproduce(py: Python<'_>, duration_scale: f64) -> PyResult<(String, String)> {
+#[pyo3(signature = (duration_scale=1.0, figures=true, shard=None, out=None))]
+fn reproduce(
+    py: Python<'_>,
+    duration_scale: f64,
+    figures: bool,
+    shard: Option<(usize, usize)>,
+    out: Option<String>,
+) -> PyResult<(String, String, Option<String>)> {
+    use squeal_files::reproduce::ReproduceStudy;
+    use squeal_study::reproduce as rp;
+    let shard = shard_of(shard)?;
+    if out.is_none() && shard.is_none() {
+        let (table, conclusions) = reproduce_quietly(py, duration_scale)?;
+        return Ok((
+            table,
+            json_text(&serde_json::Value::Array(conclusions))?,
+            None,
+        ));
+    }
+    let study = ReproduceStudy::new(duration_scale, figures, shard).map_err(study_err)?;
+    let stage = stage_for(out.as_deref(), &study.folder())?;
+    let r = compute_with(
+        py,
+        |cancel| study.run(&stage, &|_, _| Box::new(NoProgress), cancel),
+        run_err,
+    )?;
+    let dest = commit(py, stage)?;
+    let cs = r
+        .conclusions
+        .as_deref()
+        .map(rp::conclusions_json)
+        .unwrap_or_default();
+    let table = rp::table_csv(&r.results);
+    Ok((table, json_text(&serde_json::Value::Array(cs))?, Some(dest)))
+}
+
+/// The thesis reproduced without files: `table.csv` and the conclusions.
+fn reproduce_quietly(
+    py: Python<'_>,
+    duration_scale: f64,
+) -> PyResult<(String, Vec<serde_json::Value>)> {
     use squeal_study::reproduce as rp;
     let sets = rp::prepared_sets(duration_scale).map_err(study_err)?;
-    let (table, conclusions) = compute(py, |cancel| {
+    compute(py, |cancel| {
         let ids: Vec<usize> = (0..sets.len()).collect();
         let mut rs = Vec::with_capacity(ids.len());
         for (i, r) in rp::measure_sets(&sets, &ids, |_, _, _, _| Ok(()), &NoProgress, cancel)
@@ -507,8 +763,185 @@ fn reproduce(py: Python<'_>, duration_scale: f64) -> PyResult<(String, String)> 
         let sw = rp::sweeps(&rs[14].sc, cancel)?;
         let cs = rp::conclusions(&rs, &sw);
         Ok((rp::table_csv(&rs), rp::conclusions_json(&cs)))
-    })?;
-    Ok((table, json_text(&serde_json::Value::Array(conclusions))?))
+    })
+}
+
+/// The job scripts of a sharded study (`squeal slurm map|sweep|reproduce`)
+/// whose tasks run `program… args… --shard K/N --out …` and whose merge
+/// runs `program… merge …`: the study is checked as the CLI checks it (the
+/// scenario, the axes, `tasks` against the points, values or sets), the
+/// scripts written into `jobs` (default `OUT-slurm`) with the `extra` files
+/// (name, text), and with `submit` both jobs submitted. Returns `jobs`,
+/// `array`, `merge`, `out`, `submit_line`, `rerun_line` and, when submitted,
+/// `array_job` and `merge_job`.
+#[pyfunction]
+#[pyo3(signature = (study, kind, text, sets, program, args, tasks, x=None, y=None, log_x=false, log_y=false, transient=false, duration=None, param=None, duration_scale=1.0, out=None, partition=None, time=None, cpus_per_task=None, jobs=None, submit=false, extra=Vec::new()))]
+fn slurm<'py>(
+    py: Python<'py>,
+    study: &str,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    program: Vec<String>,
+    args: Vec<String>,
+    tasks: usize,
+    x: Option<(String, f64, f64, usize)>,
+    y: Option<(String, f64, f64, usize)>,
+    log_x: bool,
+    log_y: bool,
+    transient: bool,
+    duration: Option<f64>,
+    param: Option<(String, f64, f64, usize)>,
+    duration_scale: f64,
+    out: Option<String>,
+    partition: Option<String>,
+    time: Option<String>,
+    cpus_per_task: Option<usize>,
+    jobs: Option<String>,
+    submit: bool,
+    extra: Vec<(String, String)>,
+) -> PyResult<Bound<'py, PyDict>> {
+    use squeal_files::slurm::{check_job, check_tasks, submit as sbatch, write_scripts, Job};
+    let job = Job {
+        tasks,
+        partition,
+        time,
+        cpus_per_task,
+        jobs: jobs.map(Into::into),
+    };
+    check_job(&job, false, study).map_err(run_err)?;
+    let missing = |what: &str| ScenarioError::new_err(format!("slurm {study}: needs {what}"));
+    let (default_out, what, units, unit_words) = match study {
+        "map" => {
+            let (x, y) = (
+                x.ok_or_else(|| missing("x"))?,
+                y.ok_or_else(|| missing("y"))?,
+            );
+            let (sc, xa, ya) = map_inputs(
+                kind,
+                text,
+                &sets,
+                (x, y),
+                (log_x, log_y),
+                transient,
+                duration,
+            )?;
+            let n = xa.values.len() * ya.values.len();
+            let what = format!("{} map of {n} points", sc.name);
+            (format!("{}-map", sc.name), what, n, "points of the map")
+        }
+        "sweep" => {
+            let p = param.ok_or_else(|| missing("param"))?;
+            let sc = resolve(kind, text, &sets)?;
+            let spec = format!("{}={}:{}:{}", p.0, p.1, p.2, p.3);
+            let ax = map::parse_axis(&spec, "--param", false, &sc.model).map_err(input_err)?;
+            let n = ax.values.len();
+            let what = format!("{} sweep of {n} values", sc.name);
+            (format!("{}-sweep", sc.name), what, n, "values of --param")
+        }
+        "reproduce" => {
+            let sets = squeal_study::reproduce::prepared_sets(duration_scale).map_err(study_err)?;
+            let n = sets.len();
+            (
+                "reproduce".into(),
+                format!("the thesis's {n} sets"),
+                n,
+                "sets of the thesis",
+            )
+        }
+        other => {
+            return Err(ScenarioError::new_err(format!(
+                "study {other:?}: expected \"map\", \"sweep\" or \"reproduce\""
+            )))
+        }
+    };
+    check_tasks(tasks, units, unit_words).map_err(run_err)?;
+    let out = out.map_or_else(|| Path::new("out").join(default_out), Into::into);
+    let extra: Vec<(&str, &str)> = extra
+        .iter()
+        .map(|(a, b)| (a.as_str(), b.as_str()))
+        .collect();
+    let s = py
+        .allow_threads(|| write_scripts(&job, &program, &args, &out, &what, &extra))
+        .map_err(run_err)?;
+    let d = PyDict::new(py);
+    d.set_item("jobs", s.jobs.to_string_lossy().into_owned())?;
+    d.set_item("array", s.array.to_string_lossy().into_owned())?;
+    d.set_item("merge", s.merge.to_string_lossy().into_owned())?;
+    d.set_item("out", s.out.to_string_lossy().into_owned())?;
+    d.set_item("submit_line", s.submit_line())?;
+    d.set_item("rerun_line", s.rerun_line())?;
+    if submit {
+        let (a, m) = py.allow_threads(|| sbatch(&s)).map_err(run_err)?;
+        d.set_item("array_job", a)?;
+        d.set_item("merge_job", m)?;
+    }
+    Ok(d)
+}
+
+/// Gather the shard folders `dirs` into `out` (`squeal merge`): `("map",
+/// the map's dict)`, `("sweep", the sweep's dict)` or `("reproduce", a dict
+/// of `table` and `conclusions` (JSON text))`, each with `out`.
+#[pyfunction]
+fn merge<'py>(
+    py: Python<'py>,
+    dirs: Vec<String>,
+    out: String,
+) -> PyResult<(String, Bound<'py, PyDict>)> {
+    use squeal_files::merge::Merged;
+    let dirs: Vec<std::path::PathBuf> = dirs.into_iter().map(Into::into).collect();
+    let m = compute_with(
+        py,
+        |cancel| squeal_files::merge::merge(&dirs, Path::new(&out), cancel),
+        run_err,
+    )?;
+    let unit = |label: &str, name: &str| -> String {
+        label
+            .strip_prefix(name)
+            .and_then(|r| r.trim().strip_prefix('('))
+            .and_then(|r| r.strip_suffix(')'))
+            .unwrap_or("")
+            .to_string()
+    };
+    let (kind, d) = match &m.merged {
+        Merged::Map {
+            labels,
+            x,
+            y,
+            lin,
+            trans,
+            ..
+        } => {
+            let (ux, uy) = (unit(&labels.xl, &x.name), unit(&labels.yl, &y.name));
+            (
+                "map",
+                map_dict(py, x, y, (&ux, &uy), lin, trans.as_deref())?,
+            )
+        }
+        Merged::Sweep {
+            param,
+            sweep,
+            label,
+            ..
+        } => {
+            let u = unit(label, &param.name);
+            ("sweep", sweep_dict(py, &param.name, &u, sweep)?)
+        }
+        Merged::Reproduce {
+            results,
+            conclusions,
+            ..
+        } => {
+            use squeal_study::reproduce as rp;
+            let d = PyDict::new(py);
+            d.set_item("table", rp::table_csv(results))?;
+            let cs = serde_json::Value::Array(rp::conclusions_json(conclusions));
+            d.set_item("conclusions", json_text(&cs)?)?;
+            ("reproduce", d)
+        }
+    };
+    d.set_item("out", m.dest.to_string_lossy().into_owned())?;
+    Ok((kind.to_string(), d))
 }
 
 /// `squeal validate --json`'s document as JSON text (`filter`: the cases
@@ -643,7 +1076,7 @@ fn listen<'py>(
 /// A limit cycle (`squeal cycle --json`): the document as JSON text, and the
 /// orbit over one period (column names, rows × columns, event kinds per row).
 #[pyfunction]
-#[pyo3(signature = (kind, text, sets, settle_steps, settle_time, settle_tol, section=None))]
+#[pyo3(signature = (kind, text, sets, settle_steps, settle_time, settle_tol, section=None, out=None))]
 fn cycle<'py>(
     py: Python<'py>,
     kind: &str,
@@ -653,6 +1086,7 @@ fn cycle<'py>(
     settle_time: f64,
     settle_tol: f64,
     section: Option<String>,
+    out: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let sc = resolve(kind, text, &sets)?;
     let opts = squeal_study::cycle::checked_options(
@@ -663,13 +1097,23 @@ fn cycle<'py>(
         section.as_deref(),
     )
     .map_err(study_err)?;
+    let stage = out.as_deref().map(new_stage).transpose()?;
     let found = compute(py, |cancel| {
         squeal_study::cycle::of_scenario(&sc, &opts, true, cancel)
     })?;
     let mut doc = found.to_json();
     doc["scenario"] = sc.to_json();
+    let dest = match stage {
+        Some(stage) => {
+            let write = || squeal_files::cycle::write(&stage, &found, &sc, &doc);
+            py.allow_threads(write).map_err(run_err)?;
+            Some(commit(py, stage)?)
+        }
+        None => None,
+    };
     let out = PyDict::new(py);
     out.set_item("document", json_text(&doc)?)?;
+    out.set_item("out", dest)?;
     if let Some((names, rows, events)) = &found.orbit {
         let width = names.len();
         let table = Array2::from_shape_vec((rows.len(), width), rows.concat())
@@ -684,6 +1128,7 @@ fn cycle<'py>(
 /// The periodic orbit by harmonic balance (`squeal hb --json`): the
 /// document as JSON text.
 #[pyfunction]
+#[pyo3(signature = (kind, text, sets, harmonics, settle_steps, settle_time, settle_tol, guess, out=None))]
 #[allow(clippy::too_many_arguments)]
 fn hb(
     py: Python<'_>,
@@ -695,6 +1140,7 @@ fn hb(
     settle_time: f64,
     settle_tol: f64,
     guess: &str,
+    out: Option<String>,
 ) -> PyResult<String> {
     let sc = resolve(kind, text, &sets)?;
     let guess = squeal_study::hb::Guess::parse(guess)
@@ -704,29 +1150,39 @@ fn hb(
     let opts =
         squeal_study::cycle::checked_options(&sc, settle_steps, settle_time, settle_tol, None)
             .map_err(study_err)?;
+    let stage = out.as_deref().map(new_stage).transpose()?;
+    let keep = stage.is_some();
     let found = compute(py, |cancel| {
-        squeal_study::hb::of_scenario(&sc, harmonics, &opts, guess, false, cancel)
+        squeal_study::hb::of_scenario(&sc, harmonics, &opts, guess, keep, cancel)
     })?;
     let mut doc = found.to_json();
     doc["scenario"] = sc.to_json();
+    if let Some(stage) = stage {
+        let write = || squeal_files::hb::write(&stage, &found, &sc, &doc);
+        py.allow_threads(write).map_err(run_err)?;
+        commit(py, stage)?;
+    }
     json_text(&doc)
 }
 
 /// A branch of limit cycles (`squeal branch --json`): the document as JSON
 /// text.
 #[pyfunction]
+#[pyo3(signature = (kind, text, sets, param, out=None))]
 fn branch(
     py: Python<'_>,
     kind: &str,
     text: &str,
     sets: Vec<String>,
     param: (String, f64, f64, usize),
+    out: Option<String>,
 ) -> PyResult<String> {
     let sc = resolve(kind, text, &sets)?;
     let spec = format!("{}={}:{}:{}", param.0, param.1, param.2, param.3);
     let (name, lo, hi, n) = squeal_study::branch::parse_range(&spec).map_err(input_err)?;
     let values = squeal_study::branch::values(lo, hi, n);
     squeal_study::branch::check(&sc, &name, &values).map_err(study_err)?;
+    let stage = out.as_deref().map(new_stage).transpose()?;
     let br = compute(py, |cancel| {
         squeal_study::branch::follow(
             &sc,
@@ -737,7 +1193,13 @@ fn branch(
             cancel,
         )
     })?;
-    json_text(&br.to_json(&name, &sc))
+    let doc = br.to_json(&name, &sc);
+    if let Some(stage) = stage {
+        let write = || squeal_files::branch::write(&stage, &br, &sc, &name, &doc);
+        py.allow_threads(write).map_err(run_err)?;
+        commit(py, stage)?;
+    }
+    json_text(&doc)
 }
 
 /// The compiled module.
@@ -767,5 +1229,8 @@ fn _squeal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reduce, m)?)?;
     m.add_function(wrap_pyfunction!(listen, m)?)?;
     m.add_function(wrap_pyfunction!(reproduce, m)?)?;
+    m.add_function(wrap_pyfunction!(merge, m)?)?;
+    m.add_function(wrap_pyfunction!(slurm, m)?)?;
+    m.add_function(wrap_pyfunction!(plot, m)?)?;
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! Matrices read from FE files, with the names of their dofs: the common
-//! output of [`crate::dmig`] (Nastran DMIG), [`crate::abaqus`] (Abaqus
-//! `*MATRIX OUTPUT`) and [`crate::harwell_boeing`] (Harwell–Boeing, with
+//! output of the `dmig` (Nastran DMIG), `abaqus` (Abaqus
+//! `*MATRIX OUTPUT`) and `harwell_boeing` (Harwell–Boeing, with
 //! ANSYS's mapping file).
 //!
 //! Dofs are named `<node>_<component>` (`1203_3`); a Nastran scalar point is
@@ -250,85 +250,6 @@ pub(crate) mod tests {
             d[pos(r)][pos(c)] = v;
         }
         d
-    }
-
-    /// `a` equals `b` entry by entry to `rel` relative (zeros exactly).
-    fn close(a: &[Vec<f64>], b: &[Vec<f64>], rel: f64, what: &str) {
-        for (i, (ra, rb)) in a.iter().zip(b).enumerate() {
-            for (j, (x, y)) in ra.iter().zip(rb).enumerate() {
-                assert!(
-                    (x - y).abs() <= rel * y.abs(),
-                    "{what} ({i}, {j}): {x} vs {y}"
-                );
-            }
-        }
-    }
-
-    /// The fixtures of `tests/data/fe` (written by pyNastran 1.4.1, SciPy
-    /// and `make_pynastran.py`, see there) against SciPy's Matrix Market
-    /// files of the same matrices.
-    #[test]
-    fn independent_writers_agree() {
-        let dofs: Vec<&str> = include_str!("../tests/data/fe/dofs.txt").lines().collect();
-        let numbers = ["1", "2", "3", "4", "5", "6"];
-        let reference = |text: &str| {
-            let t = crate::matrix_market::parse(text).unwrap();
-            let m = LabelledMatrix {
-                name: String::new(),
-                format: "matrix-market",
-                labels: None,
-                triplets: t,
-                symmetric: false,
-            };
-            dense_by(&m, &numbers)
-        };
-        let k = reference(include_str!("../tests/data/fe/k.mtx"));
-        let u = reference(include_str!("../tests/data/fe/u.mtx"));
-        assert_eq!(k[4][4], 1.1764828785956233e4);
-        assert_eq!(u[2][5], 0.1234567890123457);
-        assert_eq!(u[5][2], 0.0);
-        for (file, text, rel) in [
-            (
-                "small",
-                include_str!("../tests/data/fe/kaax_small.bdf"),
-                2e-4,
-            ),
-            (
-                "large",
-                include_str!("../tests/data/fe/kaax_large.bdf"),
-                1e-9,
-            ),
-            ("free", include_str!("../tests/data/fe/kaax_free.bdf"), 0.0),
-        ] {
-            let m = crate::dmig::parse(text).unwrap_or_else(|e| panic!("{file}: {e}"));
-            assert_eq!(m.len(), 2);
-            assert_eq!((m[0].name.as_str(), m[1].name.as_str()), ("KAAX", "UAAX"));
-            assert!(m[0].symmetric && !m[1].symmetric);
-            assert_eq!(
-                m[0].labels.as_ref().unwrap()[..3],
-                ["1203_1", "1203_2", "1203_3"]
-            );
-            close(&dense_by(&m[0], &dofs), &k, rel, file);
-            close(&dense_by(&m[1], &dofs), &u, rel, file);
-        }
-        let hb = |text: &str, mapping: Option<&str>| harwell_boeing_parse(text, mapping);
-        let m = hb(include_str!("../tests/data/fe/k_rua.rb"), None);
-        assert!(!m.symmetric);
-        close(&dense_by(&m, &numbers), &k, 0.0, "k_rua.rb");
-        let m = hb(include_str!("../tests/data/fe/u_rua.rb"), None);
-        close(&dense_by(&m, &numbers), &u, 0.0, "u_rua.rb");
-        let m = hb(
-            include_str!("../tests/data/fe/k_rsa.matrix"),
-            Some(include_str!("../tests/data/fe/k_rsa.mapping")),
-        );
-        assert!(m.symmetric);
-        let ansys = ["1203_1", "1203_2", "1203_3", "88_3", "7_PRES", "5_6"];
-        assert_eq!(m.labels.as_deref().unwrap(), ansys);
-        close(&dense_by(&m, &ansys), &k, 1e-14, "k_rsa.matrix");
-    }
-
-    fn harwell_boeing_parse(text: &str, mapping: Option<&str>) -> LabelledMatrix {
-        crate::harwell_boeing::parse(text, mapping).unwrap()
     }
 
     #[test]

@@ -11,6 +11,7 @@ mod cycle;
 mod engine;
 mod ensemble;
 mod equilibrium;
+mod fe_formats;
 mod hb;
 mod lanczos;
 mod lumped;

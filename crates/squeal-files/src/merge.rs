@@ -42,6 +42,8 @@ pub enum Merged {
         name: String,
         /// The swept parameter.
         param: Axis,
+        /// Its axis label, `NAME (UNIT)` or the name alone.
+        label: String,
         /// The sweep, modes tracked across the shards' boundaries.
         sweep: Sweep,
     },
@@ -456,6 +458,7 @@ fn merge_sweep(shards: &[Read], n: usize, p: Axis, out: &Path) -> Result<Merge, 
     Ok(Merge {
         merged: Merged::Sweep {
             name: name.to_string(),
+            label: label.to_string(),
             param: p,
             sweep: sw,
         },

@@ -237,7 +237,8 @@ pub fn check_tasks(tasks: usize, units: usize, what: &str) -> Result<(), RunErro
 /// (`program`: the squeal executable, or Python running squeal; `args[0]`
 /// is the study's command, which also names each task's shard folder
 /// `JOBS/shard-K/CMD`), merged into `out` by `PROGRAM… merge`. `extra`
-/// files (a scenario the tasks read) are written into the jobs folder too.
+/// files (a scenario the tasks read) are written into the jobs folder too;
+/// an argument `@NAME` naming one of them becomes its path there.
 pub fn write_scripts(
     a: &Job,
     program: &[String],
@@ -281,7 +282,15 @@ pub fn write_scripts(
         "# squeal {}: {what} in {n} shards\n",
         env!("CARGO_PKG_VERSION"),
     ));
-    let study: Vec<String> = args.iter().map(|s| sh(s)).collect();
+    // `@NAME` of an extra file: that file in the jobs folder.
+    let study: Vec<String> = args
+        .iter()
+        .map(|a| match a.strip_prefix('@') {
+            Some(name) if extra.iter().any(|(n, _)| *n == name) => jobs.join(name),
+            _ => PathBuf::from(a),
+        })
+        .map(|a| sh(&a.to_string_lossy()))
+        .collect();
     let mut array = head.clone();
     array.push_str(&format!(
         "#SBATCH --job-name=squeal-{cmd}\n#SBATCH --array=0-{}\n",

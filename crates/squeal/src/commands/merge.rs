@@ -52,7 +52,9 @@ pub fn run(a: MergeArgs) -> Result<(), RunError> {
             }
             report(labels, x, y, lin, *disagree, dest, a.json)
         }
-        Merged::Sweep { name, param, sweep } => {
+        Merged::Sweep {
+            name, param, sweep, ..
+        } => {
             if !a.json {
                 crate::outln!("merged {} values from {n} shards", param.values.len());
             }

@@ -18,7 +18,7 @@
 //! Simulation and limit cycles run padded. An eigen-analysis of the padded
 //! model would add the idle dofs' modes (±i rad/s), so stability uses the
 //! size-independent paths or the exact sizes; the Floquet analysis of
-//! `crate::cycle` covers the real states only (the monodromy matrix is
+//! the cycle module covers the real states only (the monodromy matrix is
 //! block-diagonal, its real block the real model's).
 
 use super::{Combination, Lumped, Sparse, Spring};
