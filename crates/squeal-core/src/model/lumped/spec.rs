@@ -1,0 +1,125 @@
+//! A lumped model's description: dofs, masses, springs, forces, contacts and
+//! matrices, as a scenario file or a built-in gives them ([`LumpedSpec`]).
+
+use super::*;
+
+/// A linear spring–damper on `e = on·q`: generalised force `−(k e + c ė)·on`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spring {
+    /// Element name.
+    pub name: String,
+    /// The elongation's coefficients.
+    pub on: Combination,
+    /// Stiffness (N/m).
+    pub k: f64,
+    /// Damping (kg/s).
+    pub c: f64,
+}
+
+/// A constant generalised force `value·on`, optionally ramped up linearly over `ramp` seconds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Force {
+    /// Element name.
+    pub name: String,
+    /// Where it acts.
+    pub on: Combination,
+    /// Value (N).
+    pub value: f64,
+    /// Ramp time (s); 0: a step at t = 0.
+    pub ramp: f64,
+}
+
+impl Force {
+    /// Factor of the value at time `t` (1 after the ramp).
+    #[inline]
+    pub fn factor(&self, t: f64) -> f64 {
+        if self.ramp > 0.0 && t < self.ramp {
+            (t / self.ramp).max(0.0)
+        } else {
+            1.0
+        }
+    }
+}
+
+/// A dof combination as written by users: `(dof name, coefficient)`.
+pub type Terms = Vec<(String, f64)>;
+
+/// Description of a spring.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpringSpec {
+    /// Element name.
+    pub name: String,
+    /// `on`.
+    pub on: Terms,
+    /// `k` (N/m).
+    pub k: f64,
+    /// `c` (kg/s).
+    pub c: f64,
+}
+
+/// Description of a force.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ForceSpec {
+    /// Element name.
+    pub name: String,
+    /// `on`.
+    pub on: Terms,
+    /// `value` (N).
+    pub value: f64,
+    /// `ramp` (s).
+    pub ramp: f64,
+}
+
+/// Description of a contact (the keys of a `[[contact]]` table).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactSpec {
+    /// Element name.
+    pub name: String,
+    /// `normal`: the compression's coefficients (with `k`, `c`).
+    pub normal: Option<Terms>,
+    /// `k` (N/m).
+    pub k: Option<f64>,
+    /// `c` (kg/s).
+    pub c: Option<f64>,
+    /// `contact`: unilateral (default) or bilateral.
+    pub bilateral: bool,
+    /// `normal_force`: a prescribed load instead of `normal`/`k`/`c`.
+    pub normal_force: Option<f64>,
+    /// `tangent`.
+    pub tangent: Option<Terms>,
+    /// `V` (m/s).
+    pub v: f64,
+    /// The friction law with its parameters.
+    pub friction: FrictionLaw,
+    /// `alpha` (1/m).
+    pub alpha: f64,
+    /// `slope`.
+    pub slope: Terms,
+}
+
+/// Everything a lumped model is built from.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LumpedSpec {
+    /// Dof names, in state order.
+    pub dofs: Vec<String>,
+    /// `[masses]`: dof → mass (kg), added to the diagonal of `M`.
+    pub masses: Vec<(String, f64)>,
+    /// Mass matrix (symmetric positive definite with the masses added).
+    pub m: Option<Triplets>,
+    /// Stiffness matrix.
+    pub k: Option<Triplets>,
+    /// Damping matrix.
+    pub c: Option<Triplets>,
+    /// Springs.
+    pub springs: Vec<SpringSpec>,
+    /// Forces.
+    pub forces: Vec<ForceSpec>,
+    /// Contacts.
+    pub contacts: Vec<ContactSpec>,
+    /// `[params]`: shared, named parameters (`mu = 0.45`), in order.
+    pub params: Vec<(String, f64)>,
+    /// Element keys bound to expressions of `params` (`("inner.mu_k",
+    /// "mu")`); the spec's numbers for these keys are replaced by the
+    /// expressions' values when the model is built.
+    pub expressions: Vec<(String, String)>,
+}
