@@ -69,6 +69,11 @@ pub struct HbFound {
     pub multipliers: Vec<(f64, f64, bool)>,
     /// Whether every non-trivial multiplier is inside the unit circle.
     pub stable: bool,
+    /// Whether the multipliers resolve that verdict: the largest non-trivial
+    /// one is farther from the unit circle than the trivial one is from 1
+    /// (its error, since exactly 1 on an exact orbit) and than the defect
+    /// ([`unresolved`]).
+    pub stability_resolved: bool,
     /// Largest non-trivial modulus.
     pub max_multiplier: f64,
     /// Scaled `|φ_T(z₀) − z₀|` of the exact flow from the HB orbit.
@@ -345,6 +350,24 @@ fn from_hopf<M: System<N> + ?Sized, const N: usize>(
     Ok(None)
 }
 
+/// The modulus of the trivial multiplier (1 on an exact orbit; its
+/// distance from 1 measures the multipliers' error).
+fn trivial_abs<const N: usize>(c: &cycle::Cycle<N>) -> f64 {
+    c.multipliers
+        .iter()
+        .find(|m| m.trivial)
+        .map_or(1.0, |m| m.re.hypot(m.im))
+}
+
+/// Whether the Floquet verdict of `c` (one exact period from an HB orbit)
+/// is within the multipliers' error: the largest non-trivial modulus is no
+/// farther from 1 than the trivial multiplier (exactly 1 on an exact orbit)
+/// or than the scaled defect of the period.
+pub fn unresolved<const N: usize>(c: &cycle::Cycle<N>) -> bool {
+    let err = (trivial_abs(c) - 1.0).abs().max(c.residual);
+    (c.max_multiplier - 1.0).abs() <= err
+}
+
 /// An HB orbit with its table, amplitudes, notes, Floquet analysis and start.
 type Solved<const N: usize> = (
     HbOrbit,
@@ -449,7 +472,15 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
                 continue;
             };
             let c = &found.4;
-            if c.stable || attempt >= 4 || c.max_multiplier <= 1.0 || spent >= opts.settle_time {
+            // An orbit not known to be unstable (its multipliers do not
+            // resolve the verdict) is the answer: simulating past it as past
+            // an unstable one would take up to 10⁶ periods for nothing.
+            if c.stable
+                || unresolved(c)
+                || attempt >= 4
+                || c.max_multiplier <= 1.0
+                || spent >= opts.settle_time
+            {
                 break found;
             }
             let skip = cycle::past_unstable(c.period, c.max_multiplier);
@@ -523,6 +554,15 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
             "a contact sticks on the orbit: harmonic balance treats stick as slip at zero speed, not as a constraint; use squeal cycle".into(),
         );
     }
+    let resolved = !unresolved(&c);
+    if !resolved {
+        warnings.push(format!(
+            "the stability is not resolved: the largest non-trivial multiplier, |μ| = {:.9}, is as close to the unit circle as the multipliers' own error (the trivial one, exactly 1 on an exact orbit, is {:.9}; the defect {:.1e}); `squeal cycle` computes the multipliers on the exact orbit",
+            c.max_multiplier,
+            trivial_abs(&c),
+            c.residual
+        ));
+    }
     if c.residual > 1e-2 {
         warnings.push(format!(
             "one period of the exact model from the HB orbit misses its start by {:.2e} (scaled): the series is not yet the orbit (truncation, or stick), and the multipliers are those of a nearby trajectory; compare with squeal cycle",
@@ -553,6 +593,7 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
             .map(|m| (m.re, m.im, m.trivial))
             .collect(),
         stable: c.stable,
+        stability_resolved: resolved,
         max_multiplier: c.max_multiplier,
         defect: c.residual,
         events: c.events_per_period,
@@ -625,6 +666,7 @@ impl HbFound {
             "harmonics": named_json(&self.names, &self.spectrum),
             "amplitude": named_json(&self.names, &self.amplitude),
             "stable": self.stable,
+            "stability_resolved": self.stability_resolved,
             "multipliers": multipliers_json(&self.multipliers),
             "max_multiplier": self.max_multiplier,
             "events_per_period": events_json(&self.events),

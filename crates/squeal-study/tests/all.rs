@@ -4,4 +4,5 @@
 
 mod library;
 mod run_many;
+mod slow_growth;
 mod validate;

@@ -725,11 +725,12 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
     let (mut t, mut z) = (t0, z0);
     let mut spent = 0.0;
     let mut attempt = 0;
+    let mut collapses = 0;
     let mut local = *opts;
     loop {
         // Shooting that fails from a settled state (a slowly changing
         // motion that only looked periodic) settles longer, to a tighter match.
-        let (c, settled) = match settle_and_shoot(sys, t, z, &local) {
+        let (c, settled, z_settled) = match settle_and_shoot(sys, t, z, &local) {
             Err(CycleError::Shooting(_)) if attempt < 3 && local.settle_tol > 1e-6 => {
                 attempt += 1;
                 local.settle_tol *= 0.1;
@@ -738,8 +739,26 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
             other => other?,
         };
         spent += settled;
+        let collapsed = c.amplitude.iter().all(|&a| a == 0.0);
+        // An oscillation that grows by less than settle_tol a period looks
+        // periodic to settling; shooting from it then falls onto steady
+        // sliding. Where steady sliding is unstable (so the oscillation
+        // cannot be dying onto it), settle on from where it stopped, to a
+        // ten times tighter match (at most three times), until it reaches
+        // its limit cycle.
+        if collapsed
+            && collapses < 3
+            && local.settle_tol > 1e-6
+            && spent < opts.settle_time
+            && steady_unstable(sys)
+        {
+            collapses += 1;
+            local.settle_tol *= 0.1;
+            (t, z) = (t + settled, z_settled);
+            continue;
+        }
         attempt += 1;
-        if c.amplitude.iter().all(|&a| a == 0.0)
+        if collapsed
             || !c
                 .multipliers
                 .iter()
@@ -776,6 +795,20 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
             return Ok(c);
         }
     }
+}
+
+/// Whether steady sliding is linearly unstable: an eigenvalue of its state
+/// Jacobian with `Re λ > 10⁻⁹ max|λ|` (neutral modes, an idle dof's ±i,
+/// stay below that).
+fn steady_unstable<S: System<N> + ?Sized, const N: usize>(sys: &S) -> bool {
+    let Ok(z) = sys.steady_sliding() else {
+        return false;
+    };
+    let j = sys.state_jacobian(&z);
+    let a = nalgebra::DMatrix::from_fn(N, N, |r, c| j[r][c]);
+    let eig = a.complex_eigenvalues();
+    let big = eig.iter().fold(0.0f64, |m, l| m.max(l.norm()));
+    eig.iter().any(|l| l.re > 1e-9 * big)
 }
 
 /// How long to simulate on from an unstable periodic orbit of period `t`
@@ -818,13 +851,14 @@ fn decaying<const N: usize>(c: &Cycle<N>) -> Option<f64> {
     (below > 10.0 * c.residual && gap > 0.0 && below >= 0.5 * gap).then(|| t.abs().ln() / c.period)
 }
 
-/// One settling run from `(t0, z0)` and the shooting that follows it.
+/// One settling run from `(t0, z0)` and the shooting that follows it: the
+/// cycle, the time settled and the settled state shooting started from.
 fn settle_and_shoot<S: System<N> + ?Sized, const N: usize>(
     sys: &S,
     t0: f64,
     z0: [f64; N],
     opts: &CycleOptions,
-) -> Result<(Cycle<N>, f64), CycleError> {
+) -> Result<(Cycle<N>, f64, [f64; N]), CycleError> {
     // A settling run at the looser settle_rtol that fails (chatter the
     // tighter tolerance resolves, say) is repeated at the solver's own.
     let (section, z, period, settled) = match settle(sys, t0, z0, opts) {
@@ -836,16 +870,31 @@ fn settle_and_shoot<S: System<N> + ?Sized, const N: usize>(
         other => other?,
     };
     let c = shoot(sys, z, period, section, opts)?;
-    Ok((c, settled))
+    Ok((c, settled, z))
 }
 
-/// Newton shooting from a guess `(z0, period)` on `section`, then the multipliers.
+/// Newton shooting from a guess `(z0, period)` on `section`, then the
+/// multipliers, over the orbit's minimal period (see `minimal_period`).
 pub fn shoot<S: System<N> + ?Sized, const N: usize>(
     sys: &S,
     z0: [f64; N],
     period: f64,
     section: Section,
     opts: &CycleOptions,
+) -> Result<Cycle<N>, CycleError> {
+    shoot_over(sys, z0, period, section, opts, true)
+}
+
+/// [`shoot`], with the search for a shorter period (`minimal`) or without
+/// (the confirming shot over a sub-period: searching again from there
+/// would recurse without end on steady sliding, where every `t/k` returns).
+fn shoot_over<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    z0: [f64; N],
+    period: f64,
+    section: Section,
+    opts: &CycleOptions,
+    minimal: bool,
 ) -> Result<Cycle<N>, CycleError> {
     if section.index >= N {
         return Err(CycleError::Bad(format!(
@@ -876,8 +925,10 @@ pub fn shoot<S: System<N> + ?Sized, const N: usize>(
         if residual <= opts.newton_tol
             || (iterations >= 3 && last_step <= 1e-12 && residual <= 1e3 * opts.newton_tol)
         {
-            if let Some(c) = minimal_period(sys, &z, t, section, &s, opts)? {
-                return Ok(c);
+            if minimal {
+                if let Some(c) = minimal_period(sys, &z, t, section, &s, opts)? {
+                    return Ok(c);
+                }
             }
             return finish(sys, z, t, section, s, residual, iterations, p);
         }
@@ -965,7 +1016,7 @@ fn minimal_period<S: System<N> + ?Sized, const N: usize>(
         }
     }
     let Some(k) = best else { return Ok(None) };
-    match shoot(sys, *z, t / k as f64, section, opts) {
+    match shoot_over(sys, *z, t / k as f64, section, opts, false) {
         Ok(c) if dist(&c.z0, z) <= tol => Ok(Some(c)),
         _ => Ok(None),
     }

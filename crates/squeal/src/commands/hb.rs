@@ -77,7 +77,11 @@ fn print_human(f: &HbFound, sc: &Scenario) {
         f.harmonics,
         1.0 / f.period,
         f.period,
-        if f.stable { "stable" } else { "unstable" },
+        match (f.stable, f.stability_resolved) {
+            (_, false) => "stability not resolved",
+            (true, true) => "stable",
+            (false, true) => "unstable",
+        },
         f.max_multiplier
     );
     crate::outln!(
