@@ -39,6 +39,9 @@ create_exception!(
     "Bad input: the message names the offending key and value (the CLI's exit code 2)."
 );
 
+/// Stack of the worker thread a computation runs on (the CLI's main thread's).
+const WORKER_STACK: usize = 8 << 20;
+
 /// How often the calling thread looks for signals while a worker computes.
 const POLL: Duration = Duration::from_millis(20);
 
@@ -109,12 +112,17 @@ where
     let done = (Mutex::new(false), Condvar::new());
     std::thread::scope(|s| {
         let (cancel, done) = (&cancel, &done);
-        let worker = s.spawn(move || {
-            let r = catch_unwind(AssertUnwindSafe(|| work(cancel)));
-            *done.0.lock().unwrap_or_else(PoisonError::into_inner) = true;
-            done.1.notify_all();
-            r
-        });
+        // The CLI computes on its main thread (8 MB of stack); the worker
+        // gets as much, not a spawned thread's default 2 MB.
+        let worker = std::thread::Builder::new()
+            .stack_size(WORKER_STACK)
+            .spawn_scoped(s, move || {
+                let r = catch_unwind(AssertUnwindSafe(|| work(cancel)));
+                *done.0.lock().unwrap_or_else(PoisonError::into_inner) = true;
+                done.1.notify_all();
+                r
+            })
+            .map_err(|e| SquealError::new_err(format!("cannot start a worker thread: {e}")))?;
         loop {
             let finished = py.allow_threads(|| {
                 let g = done.0.lock().unwrap_or_else(PoisonError::into_inner);

@@ -400,3 +400,13 @@ def test_listen_writes_the_cli_wav_bytes_and_returns_its_samples(cli, tmp_path):
         squeal.listen("disc-pad", gain=500.0)
     with pytest.raises(squeal.ScenarioError, match="signal = nope"):
         squeal.listen("disc-pad", signal="nope", set={"duration": 0.01})
+
+
+def test_cycle_of_the_two_pad_brake_equals_the_clis(cli):
+    # Its orbit is reached by a slow growth (σT = 7e-4 a period); settling on
+    # after a collapse onto steady sliding used to recurse deep enough to
+    # overflow a 2 MB worker thread. The worker has the CLI's 8 MB.
+    doc = json.loads(cli("cycle", "two-pad-brake", "--json"))
+    c = squeal.cycle("two-pad-brake")
+    assert c["period"] == doc["period"] and c["stable"] and doc["stable"]
+    assert abs(1.0 / c["period"] - 20751.247) < 0.01
