@@ -252,3 +252,36 @@ fn branch_folds_and_meets_criticals_hopf_point() {
         assert!((h["freq_hz"].as_f64().unwrap() - f).abs() <= 1e-6 * f);
     }
 }
+
+/// The floating caliper's steady sliding grows at σ = 0.162 1/s, 7.2e-5 a
+/// period of its 2.25 kHz mode: below every settling match the retries try,
+/// a still-growing oscillation passes for settled and shooting fails. The
+/// error says so and names the `--settle-tol` that works; with it, the
+/// stable stick-slip orbit (one stick, one slip a period, 2250.34 Hz, below
+/// the linear 2250.76 Hz) that a simulation grows into.
+#[test]
+fn a_very_slow_growth_is_named_with_the_settle_tol_that_resolves_it() {
+    let d = tempfile::tempdir().unwrap();
+    let out = squeal(d.path(), &["cycle", "floating-caliper"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("grows by only 7.2e-5 a period") && err.contains("try --settle-tol 7e-6"),
+        "{err}"
+    );
+    let v = json_of(&squeal(
+        d.path(),
+        &[
+            "cycle",
+            "floating-caliper",
+            "--settle-tol",
+            "7e-6",
+            "--json",
+        ],
+    ));
+    let f = 1.0 / v["period"].as_f64().unwrap();
+    assert!((f - 2250.337).abs() < 0.01, "{f} Hz");
+    assert_eq!(v["stable"], true);
+    assert_eq!(v["events_per_period"]["stick"], 1);
+    assert_eq!(v["events_per_period"]["slip"], 1);
+}

@@ -736,6 +736,13 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
                 local.settle_tol *= 0.1;
                 continue;
             }
+            Err(CycleError::Shooting(why)) => {
+                return Err(CycleError::Shooting(slow_growth_hint(
+                    sys,
+                    why,
+                    local.settle_tol,
+                )))
+            }
             other => other?,
         };
         spent += settled;
@@ -801,14 +808,44 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
 /// Jacobian with `Re λ > 10⁻⁹ max|λ|` (neutral modes, an idle dof's ±i,
 /// stay below that).
 fn steady_unstable<S: System<N> + ?Sized, const N: usize>(sys: &S) -> bool {
-    let Ok(z) = sys.steady_sliding() else {
-        return false;
-    };
+    steady_growth(sys).is_some()
+}
+
+/// The fastest growth of steady sliding, `(σ, ω)` of its eigenvalue with
+/// the largest `Re λ > 10⁻⁹ max|λ|`; `None` if it is stable (or has none).
+fn steady_growth<S: System<N> + ?Sized, const N: usize>(sys: &S) -> Option<(f64, f64)> {
+    let z = sys.steady_sliding().ok()?;
     let j = sys.state_jacobian(&z);
     let a = nalgebra::DMatrix::from_fn(N, N, |r, c| j[r][c]);
     let eig = a.complex_eigenvalues();
     let big = eig.iter().fold(0.0f64, |m, l| m.max(l.norm()));
-    eig.iter().any(|l| l.re > 1e-9 * big)
+    eig.iter()
+        .filter(|l| l.re > 1e-9 * big)
+        .max_by(|a, b| a.re.total_cmp(&b.re))
+        .map(|l| (l.re, l.im.abs()))
+}
+
+/// A failed shooting's message, with what to try where steady sliding grows
+/// so slowly (σ·2π/ω a period below `tol`) that a still-growing
+/// oscillation passed the settling match.
+fn slow_growth_hint<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    why: String,
+    tol: f64,
+) -> String {
+    match steady_growth(sys) {
+        Some((sigma, omega)) if omega > 0.0 && sigma * std::f64::consts::TAU / omega < tol => {
+            let per = sigma * std::f64::consts::TAU / omega;
+            format!(
+                "{why}; steady sliding's mode at {:.6} Hz grows by only {per:.1e} a period \
+                 (σ = {sigma:.4e} 1/s), less than the settling match {tol:.0e}: the \
+                 motion settled on may still have been growing; try --settle-tol {:.0e}",
+                omega / std::f64::consts::TAU,
+                (0.1 * per).min(0.1 * tol)
+            )
+        }
+        _ => why,
+    }
 }
 
 /// How long to simulate on from an unstable periodic orbit of period `t`
