@@ -230,54 +230,60 @@ fn simulate<'py>(
         .as_deref()
         .map(|o| stage_for(Some(o), &sc.name))
         .transpose()?;
-    let (run, summary, spectra) = compute(py, |cancel| {
+    let run = compute(py, |cancel| {
         let start = std::time::Instant::now();
         let mut run = squeal_study::run::run(&sc, &NoProgress, cancel)?;
         run.integrate_s = start.elapsed().as_secs_f64();
-        let an = squeal_study::analysis::analyse(
-            &run,
-            &sc.model.channels(),
-            &squeal_study::analysis::SpectrumSettings::default(),
-            sc.validity,
-            &[],
-        );
-        let mut summary = squeal_study::answer::summary_json(&sc, &run, &an);
-        summary["timing"] = serde_json::json!({ "integrate_s": run.integrate_s });
-        let spectra: Vec<(String, Vec<f64>, Vec<f64>)> = an
-            .spectra
-            .into_iter()
-            .map(|c| (c.signal, c.spectrum.freq, c.spectrum.psd))
-            .collect();
-        Ok((run, summary, spectra))
+        Ok(run)
     })?;
-    let mut summary = summary;
-    let mut dest = None;
-    if let Some(stage) = stage {
-        use squeal_files::analysis::{PlotSettings, SpectrumSettings};
-        let t0 = std::time::Instant::now();
-        let spectrum = SpectrumSettings::default();
-        let plot = PlotSettings::default();
-        let files = squeal_files::run_dir::RunFiles {
-            csv: formats.iter().any(|f| f == "csv"),
-            npy: formats.iter().any(|f| f == "npy"),
-            plots,
-            wav,
-            spectrum: &spectrum,
-            plot: &plot,
-            signals: &[],
-        };
-        let write = || -> Result<serde_json::Value, squeal_files::RunError> {
-            let w = squeal_files::run_dir::write_run(&stage, &sc, &run, &files)?;
-            let mut summary = w.summary;
-            let output_s = t0.elapsed().as_secs_f64();
-            summary["timing"] =
-                serde_json::json!({ "integrate_s": run.integrate_s, "output_s": output_s });
-            squeal_files::output::write_json(&summary, &stage.path("summary.json"))?;
-            Ok(summary)
-        };
-        summary = py.allow_threads(write).map_err(run_err)?;
-        dest = Some(commit(py, stage)?);
-    }
+    // The run's analysis once: by the run folder's writer with `out`
+    // (whose summary.json is the summary), else here.
+    let (summary, an, dest) = match stage {
+        Some(stage) => {
+            use squeal_files::analysis::{PlotSettings, SpectrumSettings};
+            let t0 = std::time::Instant::now();
+            let (spectrum, plot) = (SpectrumSettings::default(), PlotSettings::default());
+            let files = squeal_files::run_dir::RunFiles {
+                csv: formats.iter().any(|f| f == "csv"),
+                npy: formats.iter().any(|f| f == "npy"),
+                plots,
+                wav,
+                spectrum: &spectrum,
+                plot: &plot,
+                signals: &[],
+            };
+            let write = |_: &Cancel| {
+                let w = squeal_files::run_dir::write_run(&stage, &sc, &run, &files)?;
+                let mut summary = w.summary;
+                let output_s = t0.elapsed().as_secs_f64();
+                summary["timing"] =
+                    serde_json::json!({ "integrate_s": run.integrate_s, "output_s": output_s });
+                squeal_files::output::write_json(&summary, &stage.path("summary.json"))?;
+                Ok((summary, w.analysis))
+            };
+            let (summary, an) = compute_with(py, write, run_err)?;
+            (summary, an, Some(commit(py, stage)?))
+        }
+        None => {
+            let (summary, an) = compute(py, |_| {
+                let an = squeal_study::analysis::analyse(
+                    &run,
+                    &sc.model.channels(),
+                    &squeal_study::analysis::SpectrumSettings::default(),
+                    sc.validity,
+                    &[],
+                );
+                let mut summary = squeal_study::answer::summary_json(&sc, &run, &an);
+                summary["timing"] = serde_json::json!({ "integrate_s": run.integrate_s });
+                Ok((summary, an))
+            })?;
+            (summary, an, None)
+        }
+    };
+    let spectra = an
+        .spectra
+        .into_iter()
+        .map(|c| (c.signal, c.spectrum.freq, c.spectrum.psd));
     let (rows, cols) = (run.len(), run.columns.len());
     let mut flat = Vec::with_capacity(rows * cols);
     for c in &run.data {
@@ -664,8 +670,13 @@ fn sweep<'py>(
         }
         None => None,
     };
-    match (&r, study.shard) {
-        (SweepResult::Shard { own, computed, .. }, Some(s)) => {
+    match &r {
+        SweepResult::Shard {
+            shard: s,
+            own,
+            computed,
+            ..
+        } => {
             let d = PyDict::new(py);
             d.set_item("shard", s.k)?;
             d.set_item("shards", s.n)?;
@@ -675,13 +686,12 @@ fn sweep<'py>(
             d.set_item("out", dest)?;
             Ok(d)
         }
-        (SweepResult::Whole(sw), _) => {
+        SweepResult::Whole(sw) => {
             let unit = map::unit_of(&study.sc.model, &study.param.name);
             let d = sweep_dict(py, &study.param.name, unit, sw)?;
             d.set_item("out", dest)?;
             Ok(d)
         }
-        _ => Err(SquealError::new_err("a sweep's shard without its shard")),
     }
 }
 

@@ -84,7 +84,7 @@ fn durations(rs: &[SetResult]) -> String {
 }
 
 /// "3 held, 2 held qualitatively, …": the grades that occur, in order.
-fn grade_counts(cs: &[Conclusion]) -> String {
+pub fn grade_counts(cs: &[Conclusion]) -> String {
     Grade::ALL
         .iter()
         .filter_map(|g| {
@@ -974,11 +974,6 @@ impl ReproduceStudy {
             conclusions: Some(cs),
         })
     }
-}
-
-/// The grades of the conclusions, counted: "5 held, 1 refuted, …".
-pub fn grade_summary(cs: &[Conclusion]) -> String {
-    grade_counts(cs)
 }
 
 #[cfg(test)]

@@ -35,6 +35,8 @@ pub enum SweepResult {
     /// A shard's part: the values it owns, the values it computed from (two
     /// before its own, to track the modes across the boundary) and its part.
     Shard {
+        /// Which shard.
+        shard: Shard,
         /// The indices of the values this shard owns.
         own: Range<usize>,
         /// The indices of the values it computed.
@@ -98,6 +100,7 @@ impl SweepStudy {
         let sw = sweep_model(m, &p.name, &p.values[computed.clone()], &self.spec, cancel)?;
         let part = part_of(&p.values, s.k, s.n, &sw);
         Ok(SweepResult::Shard {
+            shard: s,
             own,
             computed,
             part,
@@ -106,16 +109,13 @@ impl SweepStudy {
 
     /// Write what [`SweepStudy::compute`] gave into `stage`.
     pub fn write(&self, stage: &Staging, r: &SweepResult) -> Result<(), RunError> {
-        match (r, self.shard) {
-            (SweepResult::Shard { part, .. }, Some(s)) => {
+        match r {
+            SweepResult::Shard { shard, part, .. } => {
                 let study = sweep_study(&self.sc, &self.param, &self.label());
-                write_sweep_part(stage, &study, s, part)
+                write_sweep_part(stage, &study, *shard, part)
             }
-            (SweepResult::Whole(sw), _) => {
+            SweepResult::Whole(sw) => {
                 write_sweep(stage, &self.sc.name, &self.param, &self.label(), sw)
-            }
-            (SweepResult::Shard { .. }, None) => {
-                Err(RunError::Io("a sweep's shard without its --shard".into()))
             }
         }
     }

@@ -757,7 +757,7 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
             && collapses < 3
             && local.settle_tol > 1e-6
             && spent < opts.settle_time
-            && steady_unstable(sys)
+            && steady_growth(sys).is_some()
         {
             collapses += 1;
             local.settle_tol *= 0.1;
@@ -804,23 +804,14 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
     }
 }
 
-/// Whether steady sliding is linearly unstable: an eigenvalue of its state
-/// Jacobian with `Re λ > 10⁻⁹ max|λ|` (neutral modes, an idle dof's ±i,
-/// stay below that).
-fn steady_unstable<S: System<N> + ?Sized, const N: usize>(sys: &S) -> bool {
-    steady_growth(sys).is_some()
-}
-
-/// The fastest growth of steady sliding, `(σ, ω)` of its eigenvalue with
-/// the largest `Re λ > 10⁻⁹ max|λ|`; `None` if it is stable (or has none).
+/// The fastest growth of steady sliding, `(σ, ω)` of its growing eigenvalue
+/// with the largest `σ` (growing as [`crate::stability::is_growing`] says,
+/// the eigenvalues of [`crate::stability::eigenvalues`]); `None` if none
+/// grows or there is no steady sliding.
 fn steady_growth<S: System<N> + ?Sized, const N: usize>(sys: &S) -> Option<(f64, f64)> {
-    let z = sys.steady_sliding().ok()?;
-    let j = sys.state_jacobian(&z);
-    let a = nalgebra::DMatrix::from_fn(N, N, |r, c| j[r][c]);
-    let eig = a.complex_eigenvalues();
-    let big = eig.iter().fold(0.0f64, |m, l| m.max(l.norm()));
-    eig.iter()
-        .filter(|l| l.re > 1e-9 * big)
+    let ev = crate::stability::eigenvalues(sys).ok()?;
+    ev.iter()
+        .filter(|l| crate::stability::is_growing(l.re, l.im))
         .max_by(|a, b| a.re.total_cmp(&b.re))
         .map(|l| (l.re, l.im.abs()))
 }

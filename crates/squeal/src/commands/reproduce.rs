@@ -14,7 +14,7 @@
 
 use crate::run::{bars, RunError, Staging, NEVER};
 use clap::Args;
-use squeal_files::reproduce::{grade_summary, ReproduceStudy};
+use squeal_files::reproduce::{grade_counts, ReproduceStudy};
 use squeal_files::shard::Shard;
 use squeal_study::reproduce::Conclusion;
 use std::path::{Path, PathBuf};
@@ -43,7 +43,7 @@ pub struct ReproduceArgs {
 /// The terminal lines after a report: the grades, each conclusion, where
 /// the report is.
 pub fn print_summary(head: &str, cs: &[Conclusion], dest: &Path) {
-    crate::outln!("{head}: {}", grade_summary(cs));
+    crate::outln!("{head}: {}", grade_counts(cs));
     for c in cs {
         crate::outln!("  {}. {:<26} {}", c.id, c.grade.as_str(), c.thesis);
     }

@@ -51,12 +51,16 @@ pub fn run(a: SweepArgs) -> Result<(), RunError> {
     let r = study.compute(&NEVER)?;
     study.write(&stage, &r)?;
     let out = stage.commit()?;
-    let (s, own, computed) = match (&r, study.shard) {
-        (SweepResult::Shard { own, computed, .. }, Some(s)) => (s, own, computed),
-        (SweepResult::Whole(sw), _) => {
+    let (s, own, computed) = match &r {
+        SweepResult::Shard {
+            shard,
+            own,
+            computed,
+            ..
+        } => (shard, own, computed),
+        SweepResult::Whole(sw) => {
             return report(&study.sc.name, &study.param.name, sw, &out, a.json)
         }
-        _ => return Ok(()),
     };
     if a.json {
         let doc = json!({ "shard": s.k, "shards": s.n, "values": own.len(), "first": own.start, "computed_from": computed.start, "out": out });
