@@ -85,6 +85,7 @@ fn disc_pad_chain(n: usize) -> Lumped {
             on,
             k,
             c: 2e-9 * k,
+            k3: 0.0,
         });
     }
     for (name, dof, tip) in [("link_x", "x_d", 0), ("link_y", "y_d", extra - 1)] {
@@ -93,6 +94,7 @@ fn disc_pad_chain(n: usize) -> Lumped {
             on: vec![(dof.into(), 1.0), (format!("c{tip}"), -1.0)],
             k: 5.0e6,
             c: 0.5,
+            k3: 0.0,
         });
     }
     Lumped::build(&spec).unwrap()

@@ -13,6 +13,7 @@ mod ensemble;
 mod equilibrium;
 mod fe_formats;
 mod hb;
+mod hb_forced;
 mod lanczos;
 mod lumped;
 mod lumped_lanes;

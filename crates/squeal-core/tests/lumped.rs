@@ -23,6 +23,7 @@ fn spring(name: &str, on: &[(&str, f64)], k: f64, c: f64) -> SpringSpec {
         on: terms(on),
         k,
         c,
+        k3: 0.0,
     }
 }
 
@@ -32,6 +33,8 @@ fn force(name: &str, on: &[(&str, f64)], value: f64) -> ForceSpec {
         on: terms(on),
         value,
         ramp: 0.0,
+        amplitude: 0.0,
+        freq_hz: 0.0,
     }
 }
 

@@ -20,6 +20,7 @@ fn two_pad_spec() -> LumpedSpec {
         on: vec![("x_d".into(), 0.3), ("y_d".into(), 1.0)],
         k: 1.0e6,
         c: 0.5,
+        k3: 0.0,
     });
     for c in &mut spec.contacts {
         c.v = 1.0;

@@ -115,6 +115,7 @@ fn a_20_dof_model_runs_padded_and_its_disc_pad_moves_as_alone() {
             on,
             k: 1.0e6,
             c: 0.5,
+            k3: 0.0,
         });
     }
     let big = Lumped::build(&spec).unwrap();
@@ -230,6 +231,7 @@ fn an_18_dof_model_cycles_padded_with_the_exact_multipliers() {
             on: vec![(name, 1.0)],
             k,
             c,
+            k3: 0.0,
         });
         expected.push((-c / (2.0 * m), (k / m - (c / (2.0 * m)).powi(2)).sqrt()));
     }

@@ -52,6 +52,7 @@ fn embedded(extra: usize, consistent: bool) -> Lumped {
             on,
             k,
             c: 2e-8 * k,
+            k3: 0.0,
         });
     }
     if consistent {
@@ -64,6 +65,7 @@ fn embedded(extra: usize, consistent: bool) -> Lumped {
             on: vec![(dof.into(), 1.0), (format!("c{tip}"), -1.0)],
             k: 5.0e6,
             c: 0.5,
+            k3: 0.0,
         });
     }
     Lumped::build(&spec).unwrap_or_else(|e| panic!("{e}"))

@@ -22,6 +22,7 @@ fn spring(name: &str, on: &[(&str, f64)], k: f64) -> SpringSpec {
         on: terms(on),
         k,
         c: 0.0,
+        k3: 0.0,
     }
 }
 
@@ -31,6 +32,8 @@ fn force(name: &str, on: &[(&str, f64)], value: f64) -> ForceSpec {
         on: terms(on),
         value,
         ramp: 0.0,
+        amplitude: 0.0,
+        freq_hz: 0.0,
     }
 }
 

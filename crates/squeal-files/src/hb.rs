@@ -129,3 +129,110 @@ fn draw(f: &HbFound, sc: &Scenario, dir: &Path) -> Result<(), RunError> {
     .map_err(|e| RunError::Io(format!("plot: {e}")))?;
     Ok(())
 }
+
+/// Write the HB branch `br` of `sc` (`hb --param --out`), with its JSON
+/// document `doc`: `branch.csv` (one row per point: the parameter,
+/// `period`, `freq_hz`, `amplitude_<state>`…, `max_multiplier`, `stable`,
+/// `point`), `summary.json` and `hb_branch.png`/`.svg` (the amplitude of
+/// the dof that moves most against the parameter, stable solid and
+/// unstable dashed, folds marked).
+pub fn write_branch(
+    stage: &Staging,
+    br: &squeal_study::hb_branch::HbBranchFound,
+    sc: &Scenario,
+    doc: &Value,
+) -> Result<(), RunError> {
+    let path = stage.path("branch.csv");
+    let file = std::fs::File::create(&path).map_err(|e| io_err(&path, e))?;
+    let mut w = BufWriter::new(file);
+    let res = (|| -> std::io::Result<()> {
+        let mut header = vec![br.name.clone(), "period".into(), "freq_hz".into()];
+        header.extend(br.names.iter().map(|s| format!("amplitude_{s}")));
+        header.extend(["max_multiplier", "stable", "point"].map(String::from));
+        writeln!(w, "{}", header.join(","))?;
+        for r in &br.rows {
+            let mut row = vec![
+                format!("{:e}", r.value),
+                format!("{:e}", r.period),
+                format!("{:e}", 1.0 / r.period),
+            ];
+            row.extend(r.amplitude.iter().map(|a| format!("{a:e}")));
+            row.push(if r.max_multiplier.is_finite() {
+                format!("{:e}", r.max_multiplier)
+            } else {
+                String::new()
+            });
+            row.push(r.stable.to_string());
+            row.push(r.kind.to_string());
+            writeln!(w, "{}", row.join(","))?;
+        }
+        w.flush()
+    })();
+    res.map_err(|e| io_err(&path, e))?;
+    draw_branch(br, sc, stage.dir())?;
+    crate::output::write_json(doc, &stage.path("summary.json"))
+}
+
+fn draw_branch(
+    br: &squeal_study::hb_branch::HbBranchFound,
+    sc: &Scenario,
+    dir: &Path,
+) -> Result<(), RunError> {
+    if br.rows.is_empty() {
+        return Ok(());
+    }
+    let n = br.names.len() / 2;
+    // The dof that moves most anywhere on the branch.
+    let k = (0..n)
+        .max_by(|&a, &b| {
+            let top = |i: usize| br.rows.iter().map(|r| r.amplitude[i]).fold(0.0, f64::max);
+            top(a).total_cmp(&top(b))
+        })
+        .unwrap_or(0);
+    // Two series over the same points: each keeps the pieces of its own
+    // stability (a piece starts at the last point of the other's, so the
+    // line is unbroken), a NaN breaks it elsewhere.
+    let mut xs = [Vec::new(), Vec::new()];
+    let mut ys = [Vec::new(), Vec::new()];
+    for (i, r) in br.rows.iter().enumerate() {
+        let s = usize::from(!r.stable);
+        if let Some(p) = i.checked_sub(1).map(|j| &br.rows[j]) {
+            if p.stable != r.stable {
+                xs[s].push(f64::NAN);
+                ys[s].push(f64::NAN);
+                xs[s].push(p.value);
+                ys[s].push(p.amplitude[k]);
+                xs[1 - s].push(f64::NAN);
+                ys[1 - s].push(f64::NAN);
+            }
+        }
+        xs[s].push(r.value);
+        ys[s].push(r.amplitude[k]);
+    }
+    let what = if br.forced {
+        "frequency response by harmonic balance"
+    } else {
+        "periodic orbit by harmonic balance"
+    };
+    let title = format!("{}: {what} over {}", sc.name, br.name);
+    let y_label = format!("amplitude of {} (m, half peak-to-peak)", br.names[k]);
+    let mut panel = Panel::new(&title, &br.name, &y_label)
+        .with_series(Series::new("stable", &xs[0], &ys[0]).colour(0).with_gaps())
+        .with_series(
+            Series::new("unstable", &xs[1], &ys[1])
+                .colour(0)
+                .dashed(true)
+                .with_gaps(),
+        );
+    for &f in &br.folds {
+        panel = panel.with_peak(f, "fold");
+    }
+    squeal_plot::line_panels(
+        dir.join("hb_branch"),
+        &[Format::Png, Format::Svg],
+        squeal_plot::SIZE_SINGLE,
+        &[panel],
+    )
+    .map_err(|e| RunError::Io(format!("plot: {e}")))?;
+    Ok(())
+}

@@ -128,9 +128,9 @@ pub fn follow(
 }
 
 /// A family that fails once `cancel` is set.
-struct Guarded<'a, F: ?Sized> {
-    inner: &'a F,
-    cancel: &'a Cancel,
+pub(crate) struct Guarded<'a, F: ?Sized> {
+    pub(crate) inner: &'a F,
+    pub(crate) cancel: &'a Cancel,
 }
 
 impl<F: cont::Family<N> + ?Sized, const N: usize> cont::Family<N> for Guarded<'_, F> {

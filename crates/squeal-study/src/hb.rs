@@ -17,7 +17,9 @@ use crate::error::{Cancel, StudyError};
 use crate::scenario::{InputError, Scenario};
 use serde_json::{json, Map, Value};
 use squeal_core::cycle::{self, CycleError, CycleOptions};
-use squeal_core::hb::{harmonic_balance, Fourier, HbError, HbOptions, HbOrbit};
+use squeal_core::hb::{
+    forced_response, forcing_omega, harmonic_balance, Fourier, HbError, HbOptions, HbOrbit,
+};
 use squeal_core::System;
 
 /// Most harmonics `squeal hb` takes: the Jacobian is dense, `(n(2H+1))²`.
@@ -51,10 +53,15 @@ pub type Rows = Vec<Vec<f64>>;
 pub struct HbFound {
     /// Real state names (positions, then velocities).
     pub names: Vec<String>,
+    /// The final series (the real dofs' coefficients and ω).
+    pub series: Fourier,
     /// Harmonics of the final solution.
     pub harmonics: usize,
     /// Period (s).
     pub period: f64,
+    /// The forcing frequency (Hz) of a forced response; `None` for a
+    /// self-excited orbit.
+    pub forcing_hz: Option<f64>,
     /// Half peak-to-peak of each state over one period (from the series).
     pub amplitude: Vec<f64>,
     /// Per dof (position state): the mean and the amplitude `√(a_k² + b_k²)` of harmonics 1…H (m).
@@ -124,7 +131,7 @@ fn hb_err(e: HbError) -> StudyError {
 
 /// Half peak-to-peak of every state of the series (`N` states), from
 /// `16(2H+1)` samples (at least 4096).
-fn amplitudes<const N: usize>(f: &Fourier) -> [f64; N] {
+pub(crate) fn amplitudes<const N: usize>(f: &Fourier) -> [f64; N] {
     let m = (16 * (2 * f.harmonics() + 1)).max(4096);
     let mut lo = [f64::INFINITY; N];
     let mut hi = [f64::NEG_INFINITY; N];
@@ -183,9 +190,17 @@ fn ladder<M: System<N> + ?Sized, const N: usize>(
         // From the last truncation's solution, else from the simulation
         // (a coarse truncation can converge onto a smoothed orbit far from
         // the finer one, or onto the steady state).
-        let tried = match harmonic_balance(m, &guess, &hb_opts) {
+        let forced = !m.forcing_hz().is_empty();
+        let hb = |g: &Fourier| {
+            if forced {
+                forced_response(m, g, &hb_opts)
+            } else {
+                harmonic_balance(m, g, &hb_opts)
+            }
+        };
+        let tried = match hb(&guess) {
             Err(HbError::Bad(e)) => return Err(hb_err(HbError::Bad(e))),
-            Err(_) if guess != *simulated => harmonic_balance(m, simulated, &hb_opts),
+            Err(_) if guess != *simulated => hb(simulated),
             other => other,
         };
         cancel.check()?;
@@ -493,7 +508,96 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
             "--guess hopf found no stable orbit from steady sliding's growing mode; the guess was settled by simulation instead".into(),
         );
     }
-    let settled = spent;
+    let st = Stability {
+        multipliers: c
+            .multipliers
+            .iter()
+            .map(|m| (m.re, m.im, m.trivial))
+            .collect(),
+        stable: c.stable,
+        resolved: !unresolved(&c),
+        max: c.max_multiplier,
+        defect: c.residual,
+        events: c.events_per_period,
+        reference: Some(trivial_abs(&c)),
+    };
+    finish(
+        m,
+        any,
+        Hb {
+            orbit: o,
+            convergence,
+            amp,
+            notes,
+        },
+        st,
+        &z_hb,
+        spent,
+        from,
+        with_orbit,
+        opts,
+    )
+}
+
+/// A solved HB orbit with its convergence table, amplitudes and notes.
+struct Hb<const N: usize> {
+    orbit: HbOrbit,
+    convergence: Vec<Truncation>,
+    amp: [f64; N],
+    notes: Vec<String>,
+}
+
+/// The stability of an HB orbit by one exact period from it.
+struct Stability {
+    multipliers: Vec<(f64, f64, bool)>,
+    stable: bool,
+    resolved: bool,
+    max: f64,
+    defect: f64,
+    events: [u64; 5],
+    /// The trivial multiplier's modulus (autonomous), whose distance from 1
+    /// is the multipliers' error; `None` for a forced response.
+    reference: Option<f64>,
+}
+
+impl Stability {
+    /// Of a forced response: every multiplier of the monodromy counts.
+    fn forced(list: &[cycle::Multiplier], defect: f64, events: [u64; 5]) -> Stability {
+        let max = list.iter().map(|m| m.re.hypot(m.im)).fold(0.0, f64::max);
+        Stability {
+            multipliers: list.iter().map(|m| (m.re, m.im, false)).collect(),
+            stable: max < 1.0,
+            resolved: (max - 1.0).abs() > defect,
+            max,
+            defect,
+            events,
+            reference: None,
+        }
+    }
+}
+
+/// The answer from a solved orbit: the sampled period (if asked for), the
+/// warnings, the JSON-ready summary.
+#[allow(clippy::too_many_arguments)]
+fn finish<M: System<N> + ?Sized, const N: usize>(
+    m: &M,
+    any: &crate::AnyModel,
+    hb: Hb<N>,
+    st: Stability,
+    z_hb: &[f64; N],
+    settled: f64,
+    from: Guess,
+    with_orbit: bool,
+    opts: &CycleOptions,
+) -> Result<HbFound, StudyError> {
+    let Hb {
+        orbit: o,
+        convergence,
+        amp,
+        mut notes,
+    } = hb;
+    let harmonics = o.fourier.harmonics();
+    let real = real_states::<N>(m.norm_states());
     let names = any.state_names();
     let orbit = if with_orbit {
         let period = o.period();
@@ -507,7 +611,7 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
                     .collect()
             })
             .collect();
-        let flow = cycle::sample_period(m, &z_hb, period, opts).map_err(cycle_err)?;
+        let flow = cycle::sample_period(m, z_hb, period, opts).map_err(cycle_err)?;
         let exact = flow
             .t
             .iter()
@@ -554,25 +658,33 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
             "a contact sticks on the orbit: harmonic balance treats stick as slip at zero speed, not as a constraint; use squeal cycle".into(),
         );
     }
-    let resolved = !unresolved(&c);
-    if !resolved {
-        warnings.push(format!(
-            "the stability is not resolved: the largest non-trivial multiplier, |μ| = {:.9}, is as close to the unit circle as the multipliers' own error (the trivial one, exactly 1 on an exact orbit, is {:.9}; the defect {:.1e}); `squeal cycle` computes the multipliers on the exact orbit",
-            c.max_multiplier,
-            trivial_abs(&c),
-            c.residual
-        ));
+    if !st.resolved {
+        warnings.push(match st.reference {
+            Some(trivial) => format!(
+                "the stability is not resolved: the largest non-trivial multiplier, |μ| = {:.9}, is as close to the unit circle as the multipliers' own error (the trivial one, exactly 1 on an exact orbit, is {:.9}; the defect {:.1e}); `squeal cycle` computes the multipliers on the exact orbit",
+                st.max, trivial, st.defect
+            ),
+            None => format!(
+                "the stability is not resolved: the largest multiplier, |μ| = {:.9}, is within the defect {:.1e} of the unit circle",
+                st.max, st.defect
+            ),
+        });
     }
-    if c.residual > 1e-2 {
+    if st.defect > 1e-2 {
         warnings.push(format!(
             "one period of the exact model from the HB orbit misses its start by {:.2e} (scaled): the series is not yet the orbit (truncation, or stick), and the multipliers are those of a nearby trajectory; compare with squeal cycle",
-            c.residual
+            st.defect
         ));
     }
     Ok(HbFound {
         harmonics,
         period: o.period(),
+        forcing_hz: forcing_omega(m)
+            .ok()
+            .flatten()
+            .map(|w| w / std::f64::consts::TAU),
         amplitude: real.iter().map(|&i| amp[i]).collect(),
+        series: o.fourier.clone(),
         spectrum: o
             .fourier
             .coeffs
@@ -587,16 +699,12 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
         fractions: contacts,
         switches: o.switches,
         panels: o.panels,
-        multipliers: c
-            .multipliers
-            .iter()
-            .map(|m| (m.re, m.im, m.trivial))
-            .collect(),
-        stable: c.stable,
-        stability_resolved: resolved,
-        max_multiplier: c.max_multiplier,
-        defect: c.residual,
-        events: c.events_per_period,
+        multipliers: st.multipliers,
+        stable: st.stable,
+        stability_resolved: st.resolved,
+        max_multiplier: st.max,
+        defect: st.defect,
+        events: st.events,
         convergence,
         residual: o.residual,
         iterations: o.iterations,
@@ -606,6 +714,85 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
         orbit,
         names,
     })
+}
+
+/// The forced response of `m` (one harmonic forcing frequency): settled by
+/// simulating whole forcing periods from `z0` until the state at a period's
+/// start repeats to `opts.settle_tol` (scaled by each block's largest
+/// value; at most `opts.settle_time`), its last period fitted as the
+/// guess, then HB at `H/4`, `H/2`, `H` ([`forced_response`]) and the
+/// Floquet multipliers of one exact forcing period from the HB orbit
+/// (`cycle::forced_floquet`: the whole monodromy, none trivial).
+#[allow(clippy::too_many_arguments)]
+fn solve_forced<M: System<N> + ?Sized, const N: usize>(
+    m: &M,
+    any: &crate::AnyModel,
+    z0: &[f64],
+    harmonics: usize,
+    opts: &CycleOptions,
+    with_orbit: bool,
+    cancel: &Cancel,
+) -> Result<HbFound, StudyError> {
+    let omega = forcing_omega(m)
+        .map_err(hb_err)?
+        .ok_or_else(|| StudyError::Input(InputError("hb: the model is not forced".into())))?;
+    let period = std::f64::consts::TAU / omega;
+    let real = real_states::<N>(m.norm_states());
+    let n = real.len() / 2;
+    let mut z = [0.0; N];
+    z.copy_from_slice(z0);
+    let t_a = cycle::autonomous_from(m);
+    let mut t = 0.0;
+    if t_a > 0.0 {
+        (t, z) = cycle::advance(m, 0.0, z, t_a, opts).map_err(cycle_err)?;
+    }
+    let mut spent = t;
+    loop {
+        cancel.check()?;
+        let (t1, z1) = cycle::advance(m, t, z, period, opts).map_err(cycle_err)?;
+        spent += period;
+        let scale = |blk: std::ops::Range<usize>| {
+            blk.map(|i| z1[i].abs().max(z[i].abs()))
+                .fold(f64::MIN_POSITIVE, f64::max)
+        };
+        let (sp, sv) = (scale(0..N / 2), scale(N / 2..N));
+        let err = (0..N)
+            .map(|i| (z1[i] - z[i]).abs() / if i < N / 2 { sp } else { sv })
+            .fold(0.0, f64::max);
+        (t, z) = (t1, z1);
+        if err <= opts.settle_tol {
+            break;
+        }
+        if spent >= opts.settle_time {
+            return Err(StudyError::Numerical(format!(
+                "hb: the forced response did not settle in {:.4} s simulated (the state a forcing period apart still differs by {err:.2e}, scaled; --settle-tol {:e}): raise --settle-time, or the response is not periodic with the forcing",
+                spent, opts.settle_tol
+            )));
+        }
+    }
+    let orbit = cycle::sample_period(m, &z, period, opts).map_err(cycle_err)?;
+    let guess = Fourier::from_orbit(&orbit, period, n, harmonics);
+    let (o, convergence, amp, notes) = ladder(m, &guess, harmonics, &real, cancel)?;
+    let z_hb: [f64; N] = o.fourier.state(0.0);
+    let (list, defect, events) =
+        cycle::forced_floquet(m, &z_hb, period, opts).map_err(cycle_err)?;
+    let st = Stability::forced(&list, defect, events);
+    finish(
+        m,
+        any,
+        Hb {
+            orbit: o,
+            convergence,
+            amp,
+            notes,
+        },
+        st,
+        &z_hb,
+        spent,
+        Guess::Settle,
+        with_orbit,
+        opts,
+    )
 }
 
 /// The harmonic-balance orbit of a scenario with `harmonics` harmonics,
@@ -625,7 +812,15 @@ pub fn of_scenario(
     cancel.check()?;
     crate::with_sim_system!(&sc.model, m => {
         let z0 = crate::run::initial_of(m, sc)?;
-        solve(m, &sc.model, &z0, harmonics, opts, guess, with_orbit, cancel)
+        if m.forcing_hz().is_empty() {
+            solve(m, &sc.model, &z0, harmonics, opts, guess, with_orbit, cancel)
+        } else if guess == Guess::Hopf {
+            Err(StudyError::Input(InputError(
+                "--guess hopf: the model is forced (a [[force]] with amplitude and freq_hz): its response is settled by simulating whole forcing periods".into(),
+            )))
+        } else {
+            solve_forced(m, &sc.model, &z0, harmonics, opts, with_orbit, cancel)
+        }
     }, else => Err(StudyError::Input(InputError(sc.model.check_cycle_size().err().unwrap_or_default()))))
 }
 
@@ -659,6 +854,8 @@ impl HbFound {
             .collect();
         json!({
             "method": "harmonic balance",
+            "forced": self.forcing_hz.is_some(),
+            "forcing_hz": self.forcing_hz,
             "period": self.period,
             "freq_hz": 1.0 / self.period,
             "frequency_hz": 1.0 / self.period,

@@ -17,6 +17,7 @@ pub mod cycle;
 pub mod error;
 pub mod feasible;
 pub mod hb;
+pub mod hb_branch;
 pub mod input;
 pub mod inspect;
 pub mod levers;

@@ -313,24 +313,33 @@ pub fn parse(
     for (i, t) in tables(table, "spring")?.into_iter().enumerate() {
         let name = element_name("spring", i, t)?;
         let what = format!("spring '{name}'");
-        check_keys(&what, t, &["name", "on", "k", "c"])?;
+        check_keys(&what, t, &["name", "on", "k", "c", "k3"])?;
         let on = terms(&what, "on", required(&what, t, "on")?)?;
         let k = ex.value(&what, &name, "k", required(&what, t, "k")?)?;
         let c = ex.optional(&what, &name, t, "c")?.unwrap_or(0.0);
-        spec.springs.push(SpringSpec { name, on, k, c });
+        let k3 = ex.optional(&what, &name, t, "k3")?.unwrap_or(0.0);
+        spec.springs.push(SpringSpec { name, on, k, c, k3 });
     }
     for (i, t) in tables(table, "force")?.into_iter().enumerate() {
         let name = element_name("force", i, t)?;
         let what = format!("force '{name}'");
-        check_keys(&what, t, &["name", "on", "value", "ramp"])?;
+        check_keys(
+            &what,
+            t,
+            &["name", "on", "value", "ramp", "amplitude", "freq_hz"],
+        )?;
         let on = terms(&what, "on", required(&what, t, "on")?)?;
         let value = ex.value(&what, &name, "value", required(&what, t, "value")?)?;
         let ramp = ex.optional(&what, &name, t, "ramp")?.unwrap_or(0.0);
+        let amplitude = ex.optional(&what, &name, t, "amplitude")?.unwrap_or(0.0);
+        let freq_hz = ex.optional(&what, &name, t, "freq_hz")?.unwrap_or(0.0);
         spec.forces.push(ForceSpec {
             name,
             on,
             value,
             ramp,
+            amplitude,
+            freq_hz,
         });
     }
     for (i, t) in tables(table, "contact")?.into_iter().enumerate() {

@@ -342,6 +342,9 @@ fn saltation<S: System<N> + ?Sized, const N: usize>(
 
 /// The time from which the model is autonomous (after its last breakpoint,
 /// e.g. the end of a load ramp): every period is integrated from there.
+/// A model forced at one frequency `f` is periodic, not autonomous: the
+/// time is then the first whole forcing period `k/f` after the last
+/// breakpoint, so that its harmonic force is `amplitude·cos 2πf(t − t_a)`.
 pub fn autonomous_from<S: System<N> + ?Sized, const N: usize>(sys: &S) -> f64 {
     let mut t = 0.0;
     for _ in 0..1000 {
@@ -350,7 +353,55 @@ pub fn autonomous_from<S: System<N> + ?Sized, const N: usize>(sys: &S) -> f64 {
             _ => break,
         }
     }
+    if let [f] = sys.forcing_hz().as_slice() {
+        t = (t * f).ceil() / f;
+    }
     t
+}
+
+/// The refusal of shooting for a forced model (its period is the
+/// forcing's, and its flow has no trivial multiplier).
+pub fn refuse_forced<S: System<N> + ?Sized, const N: usize>(sys: &S) -> Result<(), CycleError> {
+    let f = sys.forcing_hz();
+    if f.is_empty() {
+        return Ok(());
+    }
+    Err(CycleError::Bad(format!(
+        "the model is forced (a harmonic force at {} Hz): shooting here finds self-excited orbits of an autonomous model; its periodic response is computed by `squeal hb`",
+        f.iter()
+            .map(|x| format!("{x}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    )))
+}
+
+/// The Floquet multipliers of a periodic response of a forced model: the
+/// eigenvalues of the monodromy over one forcing period `period` from `z0`
+/// at [`autonomous_from`] (variational equations and saltation matrices, as
+/// for [`floquet_from`]); none is trivial. Returns the multipliers (largest
+/// first), the scaled defect `|φ_T(z₀) − z₀|` and the events per period.
+pub fn forced_floquet<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    z0: &[f64; N],
+    period: f64,
+    opts: &CycleOptions,
+) -> Result<(Vec<Multiplier>, f64, [u64; 5]), CycleError> {
+    if !(period > 0.0 && period.is_finite()) {
+        return Err(CycleError::Bad(format!("period {period}")));
+    }
+    let first = period_flow(sys, z0, period, &[1.0; N], opts, false, None)?;
+    let mut amp = [0.0; N];
+    for i in 0..N {
+        amp[i] = 0.5 * (first.hi[i] - first.lo[i]);
+    }
+    let s = block_scales(&amp, &opts.solver);
+    let p = period_flow(sys, z0, period, &s, opts, true, None)?;
+    let defect = (0..N)
+        .map(|i| ((p.z_end[i] - z0[i]) / s[i]).abs())
+        .fold(0.0, f64::max);
+    let mut list = eigen_multipliers(&p.m);
+    sort_multipliers(&mut list);
+    Ok((list, defect, p.events))
 }
 
 /// Integrate one period `T` from `z0` with the variational equations.
@@ -542,6 +593,7 @@ pub fn settle<S: System<N> + ?Sized, const N: usize>(
     z0: [f64; N],
     opts: &CycleOptions,
 ) -> Result<(Section, [f64; N], f64, f64), CycleError> {
+    refuse_forced(sys)?;
     let n = N / 2;
     let t_end = t0 + opts.settle_time;
     let mut sopts = opts.solver;
@@ -718,6 +770,7 @@ pub fn find_cycle<S: System<N> + ?Sized, const N: usize>(
     z0: [f64; N],
     opts: &CycleOptions,
 ) -> Result<Cycle<N>, CycleError> {
+    refuse_forced(sys)?;
     // What the motion settles on is stable: an unstable periodic orbit met
     // on the way (the brake's normal vibration while the pad's mode still
     // grows, say) is left by simulating on until its instability has grown

@@ -117,7 +117,8 @@ pub struct Lumped {
     gram: [[f64; MAX_CONTACTS]; MAX_CONTACTS],
     /// `t_i·M⁻¹ n_j`.
     tn: [[f64; MAX_CONTACTS]; MAX_CONTACTS],
-    has_ramp: bool,
+    /// Whether a force varies in time (a ramp or a harmonic part).
+    time_varying: bool,
     /// Dense operators of the right-hand side (models of at most
     /// [`DENSE_FIELD_DOFS`] dofs); rebuilt whenever a parameter changes.
     dense: Option<DenseField>,
@@ -212,9 +213,9 @@ fn dense_row(c: &Combination, a: f64) -> Row {
 const STACK_DOFS: usize = 64;
 
 /// Keys of a spring, force and contact (beside the friction law's).
-pub const SPRING_KEYS: [&str; 2] = ["k", "c"];
+pub const SPRING_KEYS: [&str; 3] = ["k", "c", "k3"];
 /// See [`SPRING_KEYS`].
-pub const FORCE_KEYS: [&str; 2] = ["value", "ramp"];
+pub const FORCE_KEYS: [&str; 4] = ["value", "ramp", "amplitude", "freq_hz"];
 
 /// The small dense solve `G x = b` (`k ≤ MAX_CONTACTS`), Gaussian elimination
 /// with partial pivoting on stack arrays. `false` if `G` is singular.

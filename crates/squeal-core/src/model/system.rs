@@ -136,6 +136,12 @@ pub trait System<const N: usize>: Sync {
     fn breakpoint_after(&self, _t: f64) -> Option<f64> {
         None
     }
+    /// The distinct frequencies (Hz) of the harmonic forces acting on the
+    /// system, ascending; empty for an autonomous system (a ramp's end is
+    /// a [`System::breakpoint_after`], not a forcing).
+    fn forcing_hz(&self) -> Vec<f64> {
+        Vec::new()
+    }
     /// The steady-sliding state (all velocities zero, every contact sliding).
     fn steady_sliding(&self) -> Result<[f64; N], ModelError>;
     /// Analytic Jacobian `∂f/∂z` of the sliding equations at `z`.

@@ -26,6 +26,12 @@ pub struct HbArgs {
     /// growing mode, no simulation; settles if that finds no stable orbit).
     #[arg(long, default_value = "settle")]
     pub guess: String,
+    /// Follow the solution in one parameter, `NAME=LO:HI:N`
+    /// (pseudo-arclength through folds, steps of at most (HI−LO)/(N−1)): a
+    /// forced model's frequency-response curve with `<force>.freq_hz`, or a
+    /// self-excited orbit's branch; writes branch.csv and hb_branch.png with --out.
+    #[arg(long, value_name = "NAME=LO:HI:N")]
+    pub param: Option<String>,
     /// Print the result as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -46,8 +52,38 @@ pub fn run(a: HbArgs) -> Result<(), RunError> {
         a.settle.settle_tol,
         None,
     )?;
-    let stage = a.out.as_deref().map(Staging::new).transpose()?;
     let guess = squeal_study::hb::Guess::parse(&a.guess)?;
+    if let Some(spec) = &a.param {
+        let (name, lo, hi, steps) = squeal_study::branch::parse_range(spec)?;
+        if guess != squeal_study::hb::Guess::Settle {
+            return Err(squeal_study::scenario::InputError(
+                "--guess: with --param the first point is settled by simulation".into(),
+            )
+            .into());
+        }
+        let stage = a.out.as_deref().map(Staging::new).transpose()?;
+        let br =
+            squeal_study::hb_branch::follow(&sc, &name, lo, hi, steps, a.harmonics, &opts, &NEVER)?;
+        let mut doc = br.to_json();
+        doc["scenario"] = sc.to_json();
+        if let Some(stage) = stage {
+            squeal_files::hb::write_branch(&stage, &br, &sc, &doc)?;
+            stage.commit()?;
+        }
+        if a.json {
+            crate::outln!(
+                "{}",
+                serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
+            );
+        } else {
+            print_branch(&br, &sc);
+            if let Some(d) = &a.out {
+                crate::outln!("output: {}", d.display());
+            }
+        }
+        return Ok(());
+    }
+    let stage = a.out.as_deref().map(Staging::new).transpose()?;
     let found = of_scenario(&sc, a.harmonics, &opts, guess, a.out.is_some(), &NEVER)?;
     let mut doc = found.to_json();
     doc["scenario"] = sc.to_json();
@@ -70,6 +106,28 @@ pub fn run(a: HbArgs) -> Result<(), RunError> {
 }
 
 fn print_human(f: &HbFound, sc: &Scenario) {
+    let verdict = match (f.stable, f.stability_resolved) {
+        (_, false) => "stability not resolved",
+        (true, true) => "stable",
+        (false, true) => "unstable",
+    };
+    if let Some(fh) = f.forcing_hz {
+        crate::outln!(
+            "{} ({}): forced response by harmonic balance, H = {}: at the forcing frequency {:.6} Hz (period {:.9e} s), {verdict} (largest |multiplier| {:.9}, by one exact forcing period from the HB orbit)",
+            sc.name,
+            sc.model.name(),
+            f.harmonics,
+            fh,
+            f.period,
+            f.max_multiplier
+        );
+    } else {
+        print_autonomous(f, sc, verdict);
+    }
+    print_rest(f);
+}
+
+fn print_autonomous(f: &HbFound, sc: &Scenario, verdict: &str) {
     crate::outln!(
         "{} ({}): periodic orbit by harmonic balance, H = {}: {:.6} Hz (period {:.9e} s), {} (largest non-trivial |multiplier| {:.9}, by one exact period from the HB orbit)",
         sc.name,
@@ -77,13 +135,12 @@ fn print_human(f: &HbFound, sc: &Scenario) {
         f.harmonics,
         1.0 / f.period,
         f.period,
-        match (f.stable, f.stability_resolved) {
-            (_, false) => "stability not resolved",
-            (true, true) => "stable",
-            (false, true) => "unstable",
-        },
+        verdict,
         f.max_multiplier
     );
+}
+
+fn print_rest(f: &HbFound) {
     crate::outln!(
         "residual {:.2e} after {} Newton iterations; {} panels, {} mode switches per period; exact period from the HB state misses it by {:.2e} (scaled)",
         f.residual, f.iterations, f.panels, f.switches, f.defect
@@ -135,6 +192,60 @@ fn print_human(f: &HbFound, sc: &Scenario) {
         );
     }
     for w in &f.warnings {
+        crate::outln!("warning: {w}");
+    }
+}
+
+fn print_branch(b: &squeal_study::hb_branch::HbBranchFound, sc: &Scenario) {
+    let n = b.names.len() / 2;
+    let k = (0..n)
+        .max_by(|&x, &y| {
+            let top = |i: usize| b.rows.iter().map(|r| r.amplitude[i]).fold(0.0, f64::max);
+            top(x).total_cmp(&top(y))
+        })
+        .unwrap_or(0);
+    crate::outln!(
+        "{} ({}): {} by harmonic balance over {}, H = {}: {} points, {} fold{}; {}",
+        sc.name,
+        sc.model.name(),
+        if b.forced {
+            "frequency response"
+        } else {
+            "periodic orbit"
+        },
+        b.name,
+        b.harmonics,
+        b.rows.len(),
+        b.folds.len(),
+        if b.folds.len() == 1 { "" } else { "s" },
+        b.end
+    );
+    crate::outln!(
+        "  {:>14}  {:>14}  {:>14}  {:>12}  stability",
+        b.name,
+        "freq (Hz)",
+        format!("amp {} (m)", b.names[k]),
+        "max |mult|"
+    );
+    for r in &b.rows {
+        crate::outln!(
+            "  {:14.6e}  {:14.6}  {:14.6e}  {:12.9}  {}{}",
+            r.value,
+            1.0 / r.period,
+            r.amplitude[k],
+            r.max_multiplier,
+            match (r.stable, r.resolved) {
+                (_, false) => "not resolved",
+                (true, true) => "stable",
+                (false, true) => "unstable",
+            },
+            if r.kind == "fold" { "  (fold)" } else { "" }
+        );
+    }
+    for f in &b.folds {
+        crate::outln!("fold at {} = {f:.6e}", b.name);
+    }
+    for w in &b.warnings {
         crate::outln!("warning: {w}");
     }
 }

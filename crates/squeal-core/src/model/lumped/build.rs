@@ -153,11 +153,18 @@ impl Lumped {
                     return bad(format!("{what}: {key} = {v}: must be a finite number ≥ 0"));
                 }
             }
+            if !s.k3.is_finite() {
+                return bad(format!(
+                    "{what}: k3 = {}: must be a finite number (N/m³)",
+                    s.k3
+                ));
+            }
             springs.push(Spring {
                 name: s.name.clone(),
                 on,
                 k: s.k,
                 c: s.c,
+                k3: s.k3,
             });
         }
         let mut forces = Vec::new();
@@ -177,11 +184,31 @@ impl Lumped {
                     f.ramp
                 ));
             }
+            if !f.amplitude.is_finite() {
+                return bad(format!(
+                    "{what}: amplitude = {}: must be a finite number (N)",
+                    f.amplitude
+                ));
+            }
+            if !(f.freq_hz.is_finite() && f.freq_hz >= 0.0) {
+                return bad(format!(
+                    "{what}: freq_hz = {}: must be a finite number ≥ 0 (Hz)",
+                    f.freq_hz
+                ));
+            }
+            if f.amplitude != 0.0 && f.freq_hz == 0.0 {
+                return bad(format!(
+                    "{what}: amplitude = {}: a harmonic force needs freq_hz > 0 (a static force is its value)",
+                    f.amplitude
+                ));
+            }
             forces.push(Force {
                 name: f.name.clone(),
                 on,
                 value: f.value,
                 ramp: f.ramp,
+                amplitude: f.amplitude,
+                freq_hz: f.freq_hz,
             });
         }
         if spec.contacts.len() > MAX_CONTACTS {
@@ -298,7 +325,7 @@ impl Lumped {
             minv_t: Vec::new(),
             gram: [[0.0; MAX_CONTACTS]; MAX_CONTACTS],
             tn: [[0.0; MAX_CONTACTS]; MAX_CONTACTS],
-            has_ramp: false,
+            time_varying: false,
             dense: None,
         };
         model.refresh()?;
@@ -315,7 +342,7 @@ impl Lumped {
     /// metric) and check the stick constraints.
     pub(super) fn refresh(&mut self) -> Result<(), SpecError> {
         let n = self.dofs.len();
-        self.has_ramp = self.forces.iter().any(|f| f.ramp > 0.0);
+        self.time_varying = self.forces.iter().any(Force::varies);
         self.inv_mass = match &self.m_matrix {
             Some(m) if !m.is_diagonal() && n > SPARSE_FROM_DOFS => {
                 let mut t: Vec<faer::sparse::Triplet<usize, usize, f64>> = m

@@ -6,7 +6,9 @@ use super::*;
 impl Lumped {
     pub(super) fn rebuild_dense(&mut self) {
         let n = self.dofs.len();
-        if n > DENSE_FIELD_DOFS {
+        // Cubic springs are not folded into the linear operators: such a
+        // model takes the general right-hand side.
+        if n > DENSE_FIELD_DOFS || self.springs.iter().any(|s| s.k3 != 0.0) {
             self.dense = None;
             return;
         }
@@ -42,7 +44,7 @@ impl Lumped {
             }
         }
         let mut f0 = [0.0; DENSE_FIELD_DOFS];
-        for f in self.forces.iter().filter(|f| f.ramp <= 0.0) {
+        for f in self.forces.iter().filter(|f| !f.varies()) {
             f.on.add_scaled(&mut f0, f.value);
         }
         let mut inv_mass = [0.0; DENSE_FIELD_DOFS];
@@ -53,7 +55,7 @@ impl Lumped {
             }
             InvMass::Dense(_) | InvMass::Factored(_) => false,
         };
-        let plain = diagonal && off.is_empty() && !self.has_ramp;
+        let plain = diagonal && off.is_empty() && !self.time_varying;
         let contacts = self
             .contacts
             .iter()
@@ -195,8 +197,8 @@ impl Lumped {
             }
         } else {
             acc.copy_from_slice(&d.f0[..n]);
-            for f in self.forces.iter().filter(|f| f.ramp > 0.0) {
-                f.on.add_scaled(acc, f.value * f.factor(t));
+            for f in self.forces.iter().filter(|f| f.varies()) {
+                f.on.add_scaled(acc, f.at(t));
             }
             for (i, a) in acc.iter_mut().enumerate() {
                 *a = *a + d.kd[i] * q[i] + d.cd[i] * u[i];

@@ -5,6 +5,19 @@
 use super::*;
 
 impl Lumped {
+    /// The distinct frequencies of the harmonic forces (Hz), ascending.
+    pub fn forcing_hz(&self) -> Vec<f64> {
+        let mut f: Vec<f64> = self
+            .forces
+            .iter()
+            .filter(|f| f.is_harmonic())
+            .map(|f| f.freq_hz)
+            .collect();
+        f.sort_by(f64::total_cmp);
+        f.dedup();
+        f
+    }
+
     /// Generalised force without the stick multipliers:
     /// `F(t) − K q − C q̇ − springs − contacts` (slip friction only if
     /// `slip_friction`), into `acc[..n]`.
@@ -20,12 +33,12 @@ impl Lumped {
     ) {
         acc.fill(0.0);
         for f in &self.forces {
-            f.on.add_scaled(acc, f.value * f.factor(t));
+            f.on.add_scaled(acc, f.at(t));
         }
         for s in &self.springs {
             let e = s.on.dot(q);
             let ed = s.on.dot(u);
-            s.on.add_scaled(acc, -(s.k * e + s.c * ed));
+            s.on.add_scaled(acc, -(s.k * e + s.k3 * e * e * e + s.c * ed));
         }
         if let Some(k) = &self.k_matrix {
             k.mul_add(q, acc, -1.0);
@@ -175,7 +188,7 @@ impl Lumped {
 
     /// Whether the stick guards of `modes` are affine in the state.
     pub(super) fn stick_guards_affine(&self, modes: &Modes) -> bool {
-        !self.has_ramp
+        !self.time_varying
             && self.contacts.iter().enumerate().all(|(j, c)| {
                 let m = modes.get(j);
                 !(m == Mode::SlipPos || m == Mode::SlipNeg)

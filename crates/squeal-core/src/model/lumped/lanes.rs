@@ -198,7 +198,7 @@ impl<const N: usize> LaneField<N> for Fixed<'_, N> {
                 && m.dofs.len() == n
                 && m.dense.is_some()
                 && matches!(m.inv_mass, InvMass::Diagonal(_))
-                && !m.has_ramp
+                && !m.time_varying
                 && m.contacts.len() == first.contacts.len()
         };
         if !models.iter().all(|m| fits(m)) {

@@ -26,9 +26,16 @@ impl Lumped {
         let n = self.dofs.len();
         let (q, u) = z.split_at(n);
         for s in &self.springs {
+            // A cubic spring's tangent stiffness at q: k + 3 k3 e².
+            let k = if s.k3 != 0.0 {
+                let e = s.on.dot(q);
+                s.k + 3.0 * s.k3 * e * e
+            } else {
+                s.k
+            };
             for (a, ca) in s.on.idx.iter().zip(&s.on.coef) {
                 for (b, cb) in s.on.idx.iter().zip(&s.on.coef) {
-                    add(*a, *b, -(s.k * ca * cb));
+                    add(*a, *b, -(k * ca * cb));
                     add(*a, n + *b, -(s.c * ca * cb));
                 }
             }

@@ -71,6 +71,7 @@ impl Lumped {
                 },
                 k: 1.0,
                 c: 0.0,
+                k3: 0.0,
             });
             p.dofs.push(name);
             p.masses.push(1.0);

@@ -39,10 +39,13 @@ impl Lumped {
         for s in &self.springs {
             out.push((format!("{}.k", s.name), s.k));
             out.push((format!("{}.c", s.name), s.c));
+            out.push((format!("{}.k3", s.name), s.k3));
         }
         for f in &self.forces {
             out.push((format!("{}.value", f.name), f.value));
             out.push((format!("{}.ramp", f.name), f.ramp));
+            out.push((format!("{}.amplitude", f.name), f.amplitude));
+            out.push((format!("{}.freq_hz", f.name), f.freq_hz));
         }
         for c in &self.contacts {
             match &c.normal {
@@ -168,15 +171,18 @@ impl Lumped {
             match k {
                 "k" => s.k = nonneg(value)?,
                 "c" => s.c = nonneg(value)?,
+                "k3" => s.k3 = finite(value)?,
                 _ => return Err(unknown()),
             }
         } else if let Some(f) = self.forces.iter_mut().find(|f| f.name == el) {
             match k {
                 "value" => f.value = finite(value)?,
                 "ramp" => f.ramp = nonneg(value)?,
+                "amplitude" => f.amplitude = finite(value)?,
+                "freq_hz" => f.freq_hz = nonneg(value)?,
                 _ => return Err(unknown()),
             }
-            self.has_ramp = self.forces.iter().any(|f| f.ramp > 0.0);
+            self.time_varying = self.forces.iter().any(Force::varies);
         } else if let Some(c) = self.contacts.iter_mut().find(|c| c.name == el) {
             match (k, &mut c.normal) {
                 ("k", Normal::Elastic { k, .. }) => *k = nonneg(value)?,
@@ -255,6 +261,20 @@ impl Lumped {
 
     /// Check relations between parameters (each contact's friction law).
     pub fn validate(&self) -> Result<(), ParamError> {
+        if let Some(f) = self
+            .forces
+            .iter()
+            .find(|f| f.is_harmonic() && f.freq_hz == 0.0)
+        {
+            return Err(ParamError::Relation {
+                key: format!("{}.freq_hz", f.name),
+                value: 0.0,
+                why: format!(
+                    "leaves {}.amplitude = {} without a frequency: a harmonic force needs freq_hz > 0",
+                    f.name, f.amplitude
+                ),
+            });
+        }
         for c in &self.contacts {
             c.friction.validate().map_err(|e| prefixed(&c.name, e))?;
         }
@@ -295,6 +315,7 @@ impl Lumped {
             return match k {
                 "k" => Some(("N/m", format!("stiffness of spring {el}"))),
                 "c" => Some(("kg/s", format!("damping of spring {el}"))),
+                "k3" => Some(("N/m^3", format!("cubic stiffness of spring {el}"))),
                 _ => None,
             };
         }
@@ -302,6 +323,8 @@ impl Lumped {
             return match k {
                 "value" => Some(("N", format!("value of force {el}"))),
                 "ramp" => Some(("s", format!("ramp time of force {el}"))),
+                "amplitude" => Some(("N", format!("harmonic amplitude of force {el}"))),
+                "freq_hz" => Some(("Hz", format!("harmonic frequency of force {el}"))),
                 _ => None,
             };
         }
@@ -348,8 +371,8 @@ impl Lumped {
             };
         }
         match k {
-            "value" | "V" | "alpha" => ParamKind::Any,
-            "k" | "c" | "ramp" | "normal_force" => ParamKind::NonNegative,
+            "value" | "V" | "alpha" | "k3" | "amplitude" => ParamKind::Any,
+            "k" | "c" | "ramp" | "normal_force" | "freq_hz" => ParamKind::NonNegative,
             _ => self
                 .contacts
                 .iter()

@@ -3,7 +3,8 @@
 
 use super::*;
 
-/// A linear spring–damper on `e = on·q`: generalised force `−(k e + c ė)·on`.
+/// A spring–damper on `e = on·q`, linear unless `k3 ≠ 0` (a Duffing
+/// spring): generalised force `−(k e + k3 e³ + c ė)·on`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Spring {
     /// Element name.
@@ -14,19 +15,27 @@ pub struct Spring {
     pub k: f64,
     /// Damping (kg/s).
     pub c: f64,
+    /// Cubic stiffness (N/m³): hardening if positive.
+    pub k3: f64,
 }
 
-/// A constant generalised force `value·on`, optionally ramped up linearly over `ramp` seconds.
+/// A generalised force `(value + amplitude·cos 2πf t)·on`: a static part and
+/// an optional harmonic part of frequency `freq_hz`, both optionally ramped
+/// up linearly over `ramp` seconds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Force {
     /// Element name.
     pub name: String,
     /// Where it acts.
     pub on: Combination,
-    /// Value (N).
+    /// Static value (N).
     pub value: f64,
     /// Ramp time (s); 0: a step at t = 0.
     pub ramp: f64,
+    /// Amplitude of the harmonic part (N); 0: none.
+    pub amplitude: f64,
+    /// Frequency of the harmonic part (Hz).
+    pub freq_hz: f64,
 }
 
 impl Force {
@@ -38,6 +47,40 @@ impl Force {
         } else {
             1.0
         }
+    }
+
+    /// Whether it has a harmonic part.
+    #[inline]
+    pub fn is_harmonic(&self) -> bool {
+        self.amplitude != 0.0
+    }
+
+    /// Whether it varies in time (a ramp or a harmonic part).
+    #[inline]
+    pub fn varies(&self) -> bool {
+        self.ramp > 0.0 || self.is_harmonic()
+    }
+
+    /// The force at time `t`: `factor(t)·(value + amplitude·cos 2πf t)` (N).
+    #[inline]
+    pub fn at(&self, t: f64) -> f64 {
+        let harmonic = if self.is_harmonic() {
+            self.amplitude * (std::f64::consts::TAU * self.freq_hz * t).cos()
+        } else {
+            0.0
+        };
+        self.factor(t) * (self.value + harmonic)
+    }
+
+    /// An upper bound of `|d at/dt|` on `[t0, t0 + h]` (N/s).
+    pub fn rate_bound(&self, t0: f64) -> f64 {
+        let omega = std::f64::consts::TAU * self.freq_hz;
+        let ramping = self.ramp > 0.0 && t0 < self.ramp;
+        let mut r = self.amplitude.abs() * omega;
+        if ramping {
+            r += (self.value.abs() + self.amplitude.abs()) / self.ramp;
+        }
+        r
     }
 }
 
@@ -55,6 +98,8 @@ pub struct SpringSpec {
     pub k: f64,
     /// `c` (kg/s).
     pub c: f64,
+    /// `k3` (N/m³): cubic stiffness, 0 for a linear spring.
+    pub k3: f64,
 }
 
 /// Description of a force.
@@ -64,10 +109,14 @@ pub struct ForceSpec {
     pub name: String,
     /// `on`.
     pub on: Terms,
-    /// `value` (N).
+    /// `value` (N): the static part.
     pub value: f64,
     /// `ramp` (s).
     pub ramp: f64,
+    /// `amplitude` (N): the harmonic part's, 0 for none.
+    pub amplitude: f64,
+    /// `freq_hz` (Hz): the harmonic part's frequency.
+    pub freq_hz: f64,
 }
 
 /// Description of a contact (the keys of a `[[contact]]` table).

@@ -16,6 +16,7 @@ pub fn disc_pad_spec(m: &crate::model::disc_pad::DiscPad) -> LumpedSpec {
         on: t(&[(dof, 1.0)]),
         k,
         c,
+        k3: 0.0,
     };
     LumpedSpec {
         dofs: ["x_d", "x_p", "y_d", "y_p"].map(String::from).to_vec(),
@@ -35,6 +36,8 @@ pub fn disc_pad_spec(m: &crate::model::disc_pad::DiscPad) -> LumpedSpec {
             on: t(&[("y_p", 1.0)]),
             value: -p.N,
             ramp: p.t_ramp,
+            amplitude: 0.0,
+            freq_hz: 0.0,
         }],
         contacts: vec![ContactSpec {
             name: "pad".into(),
@@ -72,12 +75,15 @@ pub fn two_pad_spec() -> LumpedSpec {
         on: t(&[(dof, 1.0)]),
         k,
         c,
+        k3: 0.0,
     };
     let force = |name: &str, dof: &str, value: f64| ForceSpec {
         name: name.into(),
         on: t(&[(dof, 1.0)]),
         value,
         ramp: 0.0,
+        amplitude: 0.0,
+        freq_hz: 0.0,
     };
     LumpedSpec {
         dofs: ["x_d", "y_d", "x_p1", "y_p1", "x_p2", "y_p2"]

@@ -170,10 +170,16 @@ impl Lumped {
                     .iter()
                     .filter(|c| c.alpha != 0.0)
                     .map(|c| format!("{}.alpha = {}", c.name, crate::params::short(c.alpha)))
+                    .chain(
+                        self.springs
+                            .iter()
+                            .filter(|s| s.k3 != 0.0)
+                            .map(|s| format!("{}.k3 = {}", s.name, crate::params::short(s.k3))),
+                    )
                     .collect();
                 format!(
-                    "the follower force folds the steady state away {with}: it exists up to \
-                     {lambda:.4} of the given alpha ({}) and not beyond",
+                    "the follower force (or cubic spring) folds the steady state away {with}: \
+                     it exists up to {lambda:.4} of the given nonlinearity ({}) and not beyond",
                     alphas.join(", ")
                 )
             }
@@ -271,6 +277,15 @@ impl Lumped {
         r: &mut [f64],
         mut jac: Option<&mut Vec<(usize, usize, f64)>>,
     ) {
+        // Cubic springs: −λ k3 e³ a (their linear part is in A).
+        for s in self.springs.iter().filter(|s| s.k3 != 0.0) {
+            let e = s.on.dot(q);
+            s.on.add_scaled(r, -lambda * s.k3 * e * e * e);
+            if let Some(j) = jac.as_deref_mut() {
+                let g = 3.0 * lambda * s.k3 * e * e;
+                outer(j, &s.on.idx, &s.on.coef, &s.on.idx, &s.on.coef, g);
+            }
+        }
         for (i, c) in self.contacts.iter().enumerate() {
             if c.alpha == 0.0 || mask & (1 << i) == 0 {
                 continue;
@@ -303,12 +318,15 @@ impl Lumped {
         }
     }
 
-    /// Whether any closed contact of `mask` has a follower force.
+    /// Whether any closed contact of `mask` has a follower force, or a
+    /// spring is cubic (both followed from the linear solution).
     fn has_follower(&self, mask: u32) -> bool {
-        self.contacts
-            .iter()
-            .enumerate()
-            .any(|(i, c)| c.alpha != 0.0 && mask & (1 << i) != 0)
+        self.springs.iter().any(|s| s.k3 != 0.0)
+            || self
+                .contacts
+                .iter()
+                .enumerate()
+                .any(|(i, c)| c.alpha != 0.0 && mask & (1 << i) != 0)
     }
 
     /// Steady sliding for one contact set, and the contacts it contradicts.

@@ -198,18 +198,20 @@ impl<const N: usize> System<N> for Lumped {
             let v_rate = c.tangent.abs_weighted(rate, n);
             l += a[j].abs() * (dmu_max * v_rate * f_max + mu_max * f_rate);
         }
-        if self.has_ramp {
-            // ∂g/∂t from the ramped forces: |P_i·on| value/ramp while ramping.
+        if self.time_varying {
+            // ∂g/∂t from the forces that vary in time: |P_i·on| times a
+            // bound of the force's rate (ramps, harmonic parts).
             let p = self.stick_projection(modes, i);
-            for f in &self.forces {
-                if f.ramp > 0.0 && t0 < f.ramp {
+            for f in self.forces.iter().filter(|f| f.varies()) {
+                let rate = f.rate_bound(t0);
+                if rate > 0.0 {
                     let pf: f64 =
                         f.on.idx
                             .iter()
                             .zip(&f.on.coef)
                             .map(|(k, c)| c * p[*k])
                             .sum();
-                    l += h * pf.abs() * f.value.abs() / f.ramp;
+                    l += h * pf.abs() * rate;
                 }
             }
         }
@@ -280,7 +282,7 @@ impl<const N: usize> System<N> for Lumped {
 
     #[inline]
     fn breakpoint_after(&self, t: f64) -> Option<f64> {
-        if !self.has_ramp {
+        if !self.time_varying {
             return None;
         }
         self.forces
@@ -288,6 +290,10 @@ impl<const N: usize> System<N> for Lumped {
             .filter(|f| f.ramp > 0.0 && t < f.ramp)
             .map(|f| f.ramp)
             .fold(None, |a: Option<f64>, b| Some(a.map_or(b, |a| a.min(b))))
+    }
+
+    fn forcing_hz(&self) -> Vec<f64> {
+        Lumped::forcing_hz(self)
     }
 
     fn steady_sliding(&self) -> Result<[f64; N], ModelError> {
@@ -414,6 +420,9 @@ impl<const N: usize> System<N> for Fixed<'_, N> {
     #[inline]
     fn breakpoint_after(&self, t: f64) -> Option<f64> {
         <Lumped as System<N>>::breakpoint_after(self.0, t)
+    }
+    fn forcing_hz(&self) -> Vec<f64> {
+        self.0.forcing_hz()
     }
     fn steady_sliding(&self) -> Result<[f64; N], ModelError> {
         <Lumped as System<N>>::steady_sliding(self.0)

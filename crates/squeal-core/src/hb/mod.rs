@@ -44,6 +44,10 @@
 //! phase condition); Cameron & Griffin, J. Appl. Mech. 56 (1989) 149–154
 //! (alternating frequency–time).
 
+mod continuation;
+
+pub use continuation::{hb_branch, HbBranch, HbBranchEnd, HbBranchOptions, HbPoint};
+
 use crate::cycle::{autonomous_from, real_indices};
 use crate::model::{Mode, Modes, System};
 use nalgebra::{DMatrix, DVector};
@@ -338,31 +342,34 @@ struct Piece {
     modes: Modes,
 }
 
-/// The residual of the HB equations for one model and one truncation.
-struct Balance<'a, S: ?Sized, const N: usize> {
-    sys: &'a S,
+/// The unknowns of one HB problem: how the coefficients (and `ω`, if
+/// unknown) are laid out and scaled in Newton's vector `x`.
+#[derive(Debug, Clone)]
+pub(crate) struct Layout {
     /// Real dofs.
-    n: usize,
-    h: usize,
-    panels: usize,
-    t_a: f64,
+    pub(crate) n: usize,
+    pub(crate) h: usize,
+    pub(crate) panels: usize,
     /// Scale of each dof's coefficients (m) and of ω (rad/s).
-    scale: Vec<f64>,
-    omega0: f64,
-    /// Dof and coefficient of the phase condition (`b₁` of this dof).
-    phase_dof: usize,
+    pub(crate) scale: Vec<f64>,
+    pub(crate) omega0: f64,
+    /// Autonomous: the dof whose `b₁` is zero (the phase condition), and ω
+    /// is an unknown. Forced (`None`): ω is the forcing's.
+    pub(crate) phase_dof: Option<usize>,
 }
 
-impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
-    fn width(&self) -> usize {
+impl Layout {
+    pub(crate) fn width(&self) -> usize {
         2 * self.h + 1
     }
 
-    fn unknowns(&self) -> usize {
-        self.n * self.width() + 1
+    /// Unknowns (and equations): the coefficients, and ω if autonomous.
+    pub(crate) fn unknowns(&self) -> usize {
+        self.n * self.width() + usize::from(self.phase_dof.is_some())
     }
 
-    fn to_x(&self, f: &Fourier) -> Vec<f64> {
+    /// `x` of the series `f`.
+    pub(crate) fn to_x(&self, f: &Fourier) -> Vec<f64> {
         let w = self.width();
         let mut x = vec![0.0; self.unknowns()];
         for i in 0..self.n {
@@ -370,28 +377,99 @@ impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
                 x[i * w + c] = f.coeffs[i][c] / self.scale[i];
             }
         }
-        x[self.n * w] = f.omega / self.omega0;
+        if self.phase_dof.is_some() {
+            x[self.n * w] = f.omega / self.omega0;
+        }
         x
     }
 
-    fn to_fourier(&self, x: &[f64]) -> Fourier {
+    /// The series of `x`; `forced`: the forcing's ω (for a forced problem).
+    pub(crate) fn to_fourier(&self, x: &[f64], forced: Option<f64>) -> Fourier {
         let w = self.width();
         Fourier {
-            omega: x[self.n * w] * self.omega0,
+            omega: match (self.phase_dof, forced) {
+                (Some(_), _) => x[self.n * w] * self.omega0,
+                (None, Some(om)) => om,
+                (None, None) => self.omega0,
+            },
             coeffs: (0..self.n)
                 .map(|i| (0..w).map(|c| x[i * w + c] * self.scale[i]).collect())
                 .collect(),
         }
     }
+}
+
+/// The angular frequency of the harmonic forcing of `sys`, if it is forced
+/// at one frequency; an error if at several (no common period is assumed).
+pub fn forcing_omega<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+) -> Result<Option<f64>, HbError> {
+    match sys.forcing_hz().as_slice() {
+        [] => Ok(None),
+        [f] => Ok(Some(std::f64::consts::TAU * f)),
+        several => Err(HbError::Bad(format!(
+            "the model is forced at {} frequencies ({}): harmonic balance here takes one forcing frequency",
+            several.len(),
+            several
+                .iter()
+                .map(|f| format!("{f} Hz"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))),
+    }
+}
+
+/// The residual of the HB equations for one model and one truncation.
+pub(crate) struct Balance<'a, S: ?Sized, const N: usize> {
+    pub(crate) sys: &'a S,
+    pub(crate) lay: &'a Layout,
+    /// Where the period starts: the model is autonomous (or periodic with
+    /// the forcing's period) from there.
+    pub(crate) t_a: f64,
+    /// The forcing's ω, for a forced problem.
+    pub(crate) forced: Option<f64>,
+}
+
+impl<'a, S: System<N> + ?Sized, const N: usize> Balance<'a, S, N> {
+    /// The balance of `sys` on the unknowns `lay`.
+    pub(crate) fn new(sys: &'a S, lay: &'a Layout) -> Result<Self, HbError> {
+        let forced = forcing_omega(sys)?;
+        if forced.is_some() == lay.phase_dof.is_some() {
+            return Err(HbError::Bad(if forced.is_some() {
+                "the model is forced: its periodic response has the forcing's frequency (use forced_response)".into()
+            } else {
+                "the model is not forced (no force with an amplitude and freq_hz)".into()
+            }));
+        }
+        Ok(Balance {
+            sys,
+            lay,
+            t_a: crate::cycle::autonomous_from(sys),
+            forced,
+        })
+    }
+
+    fn to_fourier(&self, x: &[f64]) -> Fourier {
+        self.lay.to_fourier(x, self.forced)
+    }
+
+    /// The model's time at phase `θ` of the series of frequency `omega`.
+    #[inline]
+    fn time(&self, omega: f64, theta: f64) -> f64 {
+        match self.forced {
+            Some(_) => self.t_a + theta / omega,
+            None => self.t_a,
+        }
+    }
 
     fn modes_at(&self, f: &Fourier, theta: f64) -> Modes {
         let z: [f64; N] = f.state(theta);
-        self.sys.start_modes(self.t_a, &z)
+        self.sys.start_modes(self.time(f.omega, theta), &z)
     }
 
     /// The smooth pieces of the period: panels, split where the modes change.
     fn pieces(&self, f: &Fourier) -> Vec<Piece> {
-        let p = self.panels;
+        let p = self.lay.panels;
         let step = std::f64::consts::TAU / p as f64;
         let grid: Vec<Modes> = (0..=p)
             .map(|j| {
@@ -455,7 +533,7 @@ impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
     /// The projections `(1/π)∫ a_i basis_c dθ` (mean: `1/2π`) of the
     /// accelerations over `pieces`.
     fn project(&self, f: &Fourier, pieces: &[Piece], proj: &mut [f64]) {
-        let (n, h, w) = (self.n, self.h, self.width());
+        let (n, h, w) = (self.lay.n, self.lay.h, self.lay.width());
         proj.fill(0.0);
         let mut dz = [0.0; N];
         let mut cs = vec![(0.0, 0.0); h + 1];
@@ -468,7 +546,8 @@ impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
                 let th = mid + half * xg;
                 let wt = half * wg;
                 let z: [f64; N] = f.state(th);
-                self.sys.field(self.t_a, &pc.modes, &z, &mut dz);
+                self.sys
+                    .field(self.time(f.omega, th), &pc.modes, &z, &mut dz);
                 let (s1, c1) = th.sin_cos();
                 cs[0] = (1.0, 0.0);
                 for k in 1..=h {
@@ -489,46 +568,233 @@ impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
     }
 
     /// The scaled residual at `x` (`out` has [`Self::unknowns`] entries).
-    fn residual(&self, x: &[f64], out: &mut [f64]) {
+    pub(crate) fn residual(&self, x: &[f64], out: &mut [f64]) {
         let f = self.to_fourier(x);
         let pieces = self.pieces(&f);
-        let (n, h, w) = (self.n, self.h, self.width());
+        let lay = self.lay;
+        let (n, h, w) = (lay.n, lay.h, lay.width());
         let mut proj = vec![0.0; n * w];
         self.project(&f, &pieces, &mut proj);
         let om2 = f.omega * f.omega;
-        let norm = self.omega0 * self.omega0;
+        let norm = lay.omega0 * lay.omega0;
         for i in 0..n {
             let c = &f.coeffs[i];
             let r = &mut out[i * w..(i + 1) * w];
-            r[0] = -proj[i * w] / (norm * self.scale[i]);
+            r[0] = -proj[i * w] / (norm * lay.scale[i]);
             for k in 1..=h {
                 let kk = (k * k) as f64;
                 for j in [2 * k - 1, 2 * k] {
-                    r[j] = (-om2 * kk * c[j] - proj[i * w + j]) / (norm * self.scale[i]);
+                    r[j] = (-om2 * kk * c[j] - proj[i * w + j]) / (norm * lay.scale[i]);
                 }
             }
         }
-        out[n * w] = x[self.phase_dof * w + 2];
+        if let Some(d) = lay.phase_dof {
+            out[n * w] = x[d * w + 2];
+        }
+    }
+
+    /// The orbit at the solution `x`: its series, the time each contact
+    /// spends in each mode, the switches, whether it sticks.
+    pub(crate) fn orbit(
+        &self,
+        x: &[f64],
+        residual: f64,
+        iterations: usize,
+        converged: bool,
+    ) -> HbOrbit {
+        let fourier = self.to_fourier(x);
+        let pieces = self.pieces(&fourier);
+        let contacts = self.sys.contacts();
+        let mut fractions = vec![[0.0; 4]; contacts];
+        let mut switches = 0;
+        let mut sticks = false;
+        for (k, pc) in pieces.iter().enumerate() {
+            for (c, fr) in fractions.iter_mut().enumerate() {
+                let mode = pc.modes.get(c);
+                fr[mode.index()] += (pc.b - pc.a) / std::f64::consts::TAU;
+                sticks |= mode == Mode::Stick;
+            }
+            let next = &pieces[(k + 1) % pieces.len()];
+            switches += (0..contacts)
+                .filter(|&c| next.modes.get(c) != pc.modes.get(c))
+                .count();
+        }
+        HbOrbit {
+            fourier,
+            residual,
+            iterations,
+            fractions,
+            switches,
+            sticks,
+            panels: self.lay.panels,
+            converged,
+        }
     }
 }
 
-fn max_abs(r: &[f64]) -> f64 {
+pub(crate) fn max_abs(r: &[f64]) -> f64 {
     r.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
-fn norm2(r: &[f64]) -> f64 {
+pub(crate) fn norm2(r: &[f64]) -> f64 {
     r.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
-/// Solve the HB equations of the autonomous system `sys` from the guess
-/// `guess` (any number of harmonics: it is truncated or padded to
-/// `opts.harmonics`), module documentation. The guess should be close: a
-/// settled simulation's last period, or a neighbouring solution.
-pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
+/// The Jacobian of `residual` at `x` (residual `r`) by forward
+/// differences, one column per unknown, in parallel (each column is
+/// computed alone, so the result does not depend on the thread count).
+pub(crate) fn fd_jacobian(
+    residual: &(dyn Fn(&[f64], &mut [f64]) + Sync),
+    x: &[f64],
+    r: &[f64],
+) -> DMatrix<f64> {
+    let m = r.len();
+    let cols: Vec<Vec<f64>> = (0..x.len())
+        .into_par_iter()
+        .map(|j| {
+            let mut xp = x.to_vec();
+            let dh = 1e-7 * x[j].abs().max(1.0);
+            xp[j] += dh;
+            let mut rp = vec![0.0; m];
+            residual(&xp, &mut rp);
+            rp.iter().zip(r).map(|(a, b)| (a - b) / dh).collect()
+        })
+        .collect();
+    DMatrix::from_fn(m, x.len(), |i, j| cols[j][i])
+}
+
+/// The Jacobian at `x` (residual `r`) of a Newton problem.
+pub(crate) type JacobianFn<'a> = dyn Fn(&[f64], &[f64]) -> DMatrix<f64> + 'a;
+
+/// What [`newton`] ended with.
+pub(crate) struct Solved {
+    pub(crate) x: Vec<f64>,
+    pub(crate) residual: f64,
+    pub(crate) iterations: usize,
+    /// False if it stalled within [`STALLED`] times the tolerance.
+    pub(crate) converged: bool,
+}
+
+/// Newton's method on `residual(x) = 0` (as many equations as unknowns)
+/// with the Jacobian `jacobian(x, r)` and a backtracking line search on
+/// the residual's 2-norm; `admissible` rejects trial points (ω ≤ 0, say).
+/// `what` names the problem in errors.
+pub(crate) fn newton(
+    residual: &dyn Fn(&[f64], &mut [f64]),
+    jacobian: &JacobianFn<'_>,
+    admissible: &dyn Fn(&[f64]) -> bool,
+    x0: Vec<f64>,
+    tol: f64,
+    max_iterations: usize,
+    what: &str,
+) -> Result<Solved, HbError> {
+    let m = x0.len();
+    let mut x = x0;
+    let mut r = vec![0.0; m];
+    residual(&x, &mut r);
+    let mut iterations = 0;
+    let mut stalled = false;
+    let mut approximate = false;
+    let mut last = f64::INFINITY;
+    loop {
+        let res = max_abs(&r);
+        if !res.is_finite() {
+            return Err(HbError::NotConverged(format!(
+                "the residual is not finite after {iterations} iterations ({what})"
+            )));
+        }
+        if res <= tol || stalled || (res <= 1e2 * tol && res > 0.5 * last) {
+            break;
+        }
+        if iterations >= max_iterations {
+            if res <= STALLED * tol {
+                approximate = true;
+                break;
+            }
+            return Err(HbError::NotConverged(format!(
+                "residual {res:.3e} after {iterations} Newton iterations ({what})"
+            )));
+        }
+        iterations += 1;
+        last = res;
+        let jac = jacobian(&x, &r);
+        let rhs = DVector::from_iterator(m, r.iter().map(|v| -v));
+        let dx = jac.lu().solve(&rhs).ok_or_else(|| {
+            HbError::NotConverged(format!(
+                "the Jacobian is singular at iteration {iterations} ({what})"
+            ))
+        })?;
+        // Backtracking on the residual's 2-norm.
+        let r0 = norm2(&r);
+        let mut lambda = 1.0;
+        let mut rt = vec![0.0; m];
+        loop {
+            let xt: Vec<f64> = x
+                .iter()
+                .zip(dx.iter())
+                .map(|(a, d)| a + lambda * d)
+                .collect();
+            if admissible(&xt) {
+                residual(&xt, &mut rt);
+                if norm2(&rt) < r0 || lambda < 1e-3 {
+                    x = xt;
+                    std::mem::swap(&mut r, &mut rt);
+                    break;
+                }
+            }
+            lambda *= 0.5;
+            if lambda < 1e-3 {
+                // At the round-off floor of the projections: converged.
+                if max_abs(&r) <= 1e2 * tol {
+                    stalled = true;
+                    break;
+                }
+                if max_abs(&r) <= STALLED * tol {
+                    stalled = true;
+                    approximate = true;
+                    break;
+                }
+                return Err(HbError::NotConverged(format!(
+                    "no Newton step lowers the residual {:.3e} (iteration {iterations}, {what})",
+                    max_abs(&r)
+                )));
+            }
+        }
+    }
+    Ok(Solved {
+        residual: max_abs(&r),
+        x,
+        iterations,
+        converged: !approximate,
+    })
+}
+
+/// Check that the first half of the field of `sys` is the velocities
+/// (`q̇ = v`), as HB's second-order form needs.
+fn check_second_order<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    guess: &Fourier,
+    n: usize,
+) -> Result<(), HbError> {
+    let t_a = autonomous_from(sys);
+    let z: [f64; N] = guess.state(0.3);
+    let mut dz = [0.0; N];
+    sys.field(t_a, &sys.start_modes(t_a, &z), &z, &mut dz);
+    if (0..n).any(|i| dz[i] != z[N / 2 + i]) {
+        return Err(HbError::Bad(format!(
+            "{}: harmonic balance needs states that are positions and their velocities",
+            sys.system_name()
+        )));
+    }
+    Ok(())
+}
+
+/// The checked guess resized to `opts.harmonics`, and the number of real dofs.
+fn checked_guess<S: System<N> + ?Sized, const N: usize>(
     sys: &S,
     guess: &Fourier,
     opts: &HbOptions,
-) -> Result<HbOrbit, HbError> {
+) -> Result<(Fourier, usize), HbError> {
     let real = real_indices(sys);
     let n = real.len() / 2;
     if guess.coeffs.len() != n {
@@ -546,24 +812,37 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
             guess.omega
         )));
     }
-    let h = opts.harmonics;
-    let guess = guess.resized(h);
-    // The first half of the field must be the velocities (q̇ = v).
-    let t_a = autonomous_from(sys);
-    {
-        let z: [f64; N] = guess.state(0.3);
-        let mut dz = [0.0; N];
-        sys.field(t_a, &sys.start_modes(t_a, &z), &z, &mut dz);
-        if (0..n).any(|i| dz[i] != z[N / 2 + i]) {
-            return Err(HbError::Bad(format!(
-                "{}: harmonic balance needs states that are positions and their velocities",
-                sys.system_name()
-            )));
-        }
+    let guess = guess.resized(opts.harmonics);
+    check_second_order(sys, &guess, n)?;
+    Ok((guess, n))
+}
+
+/// Largest harmonic amplitude of each dof of `f`.
+fn harmonic_amplitudes(f: &Fourier) -> Vec<f64> {
+    let h = f.harmonics();
+    (0..f.coeffs.len())
+        .map(|i| (1..=h).map(|k| f.amplitude(i, k)).fold(0.0, f64::max))
+        .collect()
+}
+
+/// Solve the HB equations of the autonomous system `sys` from the guess
+/// `guess` (any number of harmonics: it is truncated or padded to
+/// `opts.harmonics`), module documentation. The guess should be close: a
+/// settled simulation's last period, or a neighbouring solution.
+pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    guess: &Fourier,
+    opts: &HbOptions,
+) -> Result<HbOrbit, HbError> {
+    if let Some(om) = forcing_omega(sys)? {
+        return Err(HbError::Bad(format!(
+            "the model is forced at {:.6} Hz: its periodic response has the forcing's frequency (forced response, not a self-excited orbit)",
+            om / std::f64::consts::TAU
+        )));
     }
-    let amp: Vec<f64> = (0..n)
-        .map(|i| (1..=h).map(|k| guess.amplitude(i, k)).fold(0.0, f64::max))
-        .collect();
+    let (guess, n) = checked_guess(sys, guess, opts)?;
+    let h = opts.harmonics;
+    let amp = harmonic_amplitudes(&guess);
     let top = amp.iter().cloned().fold(0.0, f64::max);
     if !(top > 0.0 && top.is_finite()) {
         return Err(HbError::Bad(
@@ -575,134 +854,99 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
         .unwrap_or(0);
     let delta = guess.coeffs[phase_dof][2].atan2(guess.coeffs[phase_dof][1]);
     let guess = guess.shifted(delta);
-    let bal = Balance::<S, N> {
-        sys,
+    let lay = Layout {
         n,
         h,
         panels: opts.panel_count(),
-        t_a,
         scale: amp.iter().map(|a| a.max(1e-6 * top)).collect(),
         omega0: guess.omega,
-        phase_dof,
+        phase_dof: Some(phase_dof),
     };
-    let m = bal.unknowns();
-    let mut x = bal.to_x(&guess);
-    let mut r = vec![0.0; m];
-    bal.residual(&x, &mut r);
-    let mut iterations = 0;
-    let mut stalled = false;
-    let mut approximate = false;
-    let mut last = f64::INFINITY;
-    loop {
-        let res = max_abs(&r);
-        if !res.is_finite() {
-            return Err(HbError::NotConverged(format!(
-                "the residual is not finite after {iterations} iterations"
-            )));
-        }
-        if res <= opts.newton_tol || stalled || (res <= 1e2 * opts.newton_tol && res > 0.5 * last) {
-            break;
-        }
-        if iterations >= opts.newton_iterations {
-            if res <= STALLED * opts.newton_tol {
-                approximate = true;
-                break;
-            }
-            return Err(HbError::NotConverged(format!(
-                "residual {res:.3e} after {iterations} Newton iterations (H = {h})"
-            )));
-        }
-        iterations += 1;
-        last = res;
-        // The Jacobian by forward differences, one column per unknown (in
-        // parallel; each column is computed alone, so the result does not
-        // depend on the thread count).
-        let cols: Vec<Vec<f64>> = (0..m)
-            .into_par_iter()
-            .map(|j| {
-                let mut xp = x.clone();
-                let dh = 1e-7 * x[j].abs().max(1.0);
-                xp[j] += dh;
-                let mut rp = vec![0.0; m];
-                bal.residual(&xp, &mut rp);
-                rp.iter().zip(&r).map(|(a, b)| (a - b) / dh).collect()
-            })
-            .collect();
-        let jac = DMatrix::from_fn(m, m, |i, j| cols[j][i]);
-        let rhs = DVector::from_iterator(m, r.iter().map(|v| -v));
-        let dx = jac.lu().solve(&rhs).ok_or_else(|| {
-            HbError::NotConverged(format!(
-                "the Jacobian is singular at iteration {iterations} (H = {h})"
-            ))
-        })?;
-        // Backtracking on the residual's 2-norm; ω kept positive.
-        let r0 = norm2(&r);
-        let mut lambda = 1.0;
-        let mut rt = vec![0.0; m];
-        loop {
-            let xt: Vec<f64> = x
-                .iter()
-                .zip(dx.iter())
-                .map(|(a, d)| a + lambda * d)
-                .collect();
-            if xt[m - 1] > 0.0 {
-                bal.residual(&xt, &mut rt);
-                if norm2(&rt) < r0 || lambda < 1e-3 {
-                    x = xt;
-                    std::mem::swap(&mut r, &mut rt);
-                    break;
-                }
-            }
-            lambda *= 0.5;
-            if lambda < 1e-3 {
-                // At the round-off floor of the projections: converged.
-                if max_abs(&r) <= 1e2 * opts.newton_tol {
-                    stalled = true;
-                    break;
-                }
-                if max_abs(&r) <= STALLED * opts.newton_tol {
-                    stalled = true;
-                    approximate = true;
-                    break;
-                }
-                return Err(HbError::NotConverged(format!(
-                    "no Newton step lowers the residual {:.3e} (iteration {iterations}, H = {h})",
-                    max_abs(&r)
-                )));
-            }
-        }
-    }
-    let fourier = bal.to_fourier(&x);
-    let left = (0..n)
-        .map(|i| (1..=h).map(|k| fourier.amplitude(i, k)).fold(0.0, f64::max))
+    let bal = Balance::<S, N>::new(sys, &lay)?;
+    let m = lay.unknowns();
+    let res = |x: &[f64], out: &mut [f64]| bal.residual(x, out);
+    let solved = newton(
+        &res,
+        &|x, r| fd_jacobian(&res, x, r),
+        &|x| x[m - 1] > 0.0,
+        lay.to_x(&guess),
+        opts.newton_tol,
+        opts.newton_iterations,
+        &format!("H = {h}"),
+    )?;
+    let fourier = bal.to_fourier(&solved.x);
+    let left = harmonic_amplitudes(&fourier)
+        .into_iter()
         .fold(0.0, f64::max);
     if left < 1e-6 * top {
         return Err(HbError::Collapsed(left / top));
     }
-    let pieces = bal.pieces(&fourier);
-    let contacts = sys.contacts();
-    let mut fractions = vec![[0.0; 4]; contacts];
-    let mut switches = 0;
-    let mut sticks = false;
-    for (k, pc) in pieces.iter().enumerate() {
-        for (c, fr) in fractions.iter_mut().enumerate() {
-            let mode = pc.modes.get(c);
-            fr[mode.index()] += (pc.b - pc.a) / std::f64::consts::TAU;
-            sticks |= mode == Mode::Stick;
-        }
-        let next = &pieces[(k + 1) % pieces.len()];
-        switches += (0..contacts)
-            .filter(|&c| next.modes.get(c) != pc.modes.get(c))
-            .count();
-    }
-    Ok(HbOrbit {
-        fourier,
-        residual: max_abs(&r),
-        iterations,
-        fractions,
-        switches,
-        sticks,
-        panels: bal.panels,
-        converged: !approximate,
-    })
+    Ok(bal.orbit(
+        &solved.x,
+        solved.residual,
+        solved.iterations,
+        solved.converged,
+    ))
+}
+
+/// The coefficient scales of a forced problem: each dof's largest harmonic
+/// amplitude in `guess`, floored at 1e-6 of the largest, and, where the
+/// guess does not move at all, at `floor` (m).
+pub(crate) fn forced_scales(guess: &Fourier, floor: f64) -> Vec<f64> {
+    let amp = harmonic_amplitudes(guess);
+    let top = amp.iter().cloned().fold(0.0, f64::max);
+    let base = if top > 0.0 && top.is_finite() {
+        top
+    } else {
+        floor
+    };
+    amp.iter().map(|a| a.max(1e-6 * base)).collect()
+}
+
+/// The periodic response of the system `sys` forced harmonically at one
+/// frequency `Ω` (its [`System::forcing_hz`]): the same Galerkin
+/// equations as [`harmonic_balance`] with `ω = Ω` given, so no phase
+/// condition (the forcing fixes the time origin: the force is
+/// `amplitude·cos Ωt` at phase `θ = Ωt`). `guess` gives the starting
+/// coefficients (its `omega` is ignored); a series of zero harmonics at
+/// the static state is a valid guess. Krack & Gross (2019), ch. 2.
+pub fn forced_response<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    guess: &Fourier,
+    opts: &HbOptions,
+) -> Result<HbOrbit, HbError> {
+    let Some(omega) = forcing_omega(sys)? else {
+        return Err(HbError::Bad(
+            "the model is not forced: give a [[force]] an amplitude and freq_hz".into(),
+        ));
+    };
+    let mut g = guess.clone();
+    g.omega = omega;
+    let (guess, n) = checked_guess(sys, &g, opts)?;
+    let h = opts.harmonics;
+    let lay = Layout {
+        n,
+        h,
+        panels: opts.panel_count(),
+        scale: forced_scales(&guess, 1.0),
+        omega0: omega,
+        phase_dof: None,
+    };
+    let bal = Balance::<S, N>::new(sys, &lay)?;
+    let res = |x: &[f64], out: &mut [f64]| bal.residual(x, out);
+    let solved = newton(
+        &res,
+        &|x, r| fd_jacobian(&res, x, r),
+        &|_| true,
+        lay.to_x(&guess),
+        opts.newton_tol,
+        opts.newton_iterations,
+        &format!("H = {h}"),
+    )?;
+    Ok(bal.orbit(
+        &solved.x,
+        solved.residual,
+        solved.iterations,
+        solved.converged,
+    ))
 }
