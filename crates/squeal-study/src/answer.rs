@@ -216,6 +216,10 @@ pub struct Answer {
     /// The run's sound over the judged window, from the scenario's
     /// radiating surfaces ([`crate::radiation`]); the reason when there is none.
     pub sound: Result<Sound, String>,
+    /// The forcing frequency (Hz) whose multiple the measured line is,
+    /// within its uncertainty, for a model with harmonic forces: the line is
+    /// then (at least in part) the forced response, not self-excited squeal.
+    pub forced_hz: Option<f64>,
 }
 
 /// The most unstable eigenvalue with `ω ≥ 0` (largest real part; among
@@ -225,6 +229,19 @@ fn leading(ev: &[Complex<f64>]) -> Option<Complex<f64>> {
         .copied()
         .filter(|e| e.im >= 0.0)
         .max_by(|a, b| a.re.total_cmp(&b.re).then(b.im.total_cmp(&a.im)))
+}
+
+/// The forcing frequency of `model` (Hz) of which `hz` is a whole multiple
+/// (1 to 10), within `uncertainty` (or 10⁻³ of `hz`), if any.
+fn forcing_match(model: &AnyModel, hz: f64, uncertainty: Option<f64>) -> Option<f64> {
+    let AnyModel::Lumped(l) = model else {
+        return None;
+    };
+    let tol = uncertainty.unwrap_or(0.0).max(1e-3 * hz);
+    l.forcing_hz().into_iter().find(|&f| {
+        let k = (hz / f).round();
+        (1.0..=10.0).contains(&k) && (hz - k * f).abs() <= tol
+    })
 }
 
 /// The time the last force ramp of a lumped model ends (0 for none).
@@ -245,6 +262,7 @@ impl Answer {
             squeal: None,
             verdict: None,
             sound: Sound::of(&sc.radiation, run, an.judgement.window),
+            forced_hz: None,
         };
         let names = sc.model.state_names();
         // One steady-sliding solve and one state matrix: its eigenvalues
@@ -323,6 +341,11 @@ impl Answer {
                 ));
             }
         }
+        answer.forced_hz = answer
+            .squeal
+            .as_ref()
+            .filter(|s| s.source == Source::Run)
+            .and_then(|s| forcing_match(&sc.model, s.frequency_hz, s.uncertainty_hz));
         answer
     }
 
@@ -366,6 +389,7 @@ impl Answer {
             "dominant_hz": s.dominant_hz,
             "lengthen_s": s.lengthen_s,
             "note": s.note,
+            "forced_hz": self.forced_hz,
         })
     }
 
@@ -461,6 +485,16 @@ impl Answer {
         let verdict = self.verdict(an);
         if s.source == Source::Linear {
             return format!("{} ({what}); verdict {verdict}", s.note);
+        }
+        if let Some(f) = self.forced_hz {
+            return format!(
+                "responds at {} ± {} ({what}), a multiple of the forcing frequency {} (a forced response, not self-excited squeal; `squeal hb` computes it): {} RMS = {:.1} dB re 1 m/s; verdict {verdict}",
+                si(s.frequency_hz, "Hz", 5),
+                si(s.uncertainty_hz.unwrap_or(0.0), "Hz", 2),
+                si(f, "Hz", 6),
+                si(s.rms.unwrap_or(0.0), "m/s", 3),
+                s.level_db.unwrap_or(f64::NAN),
+            );
         }
         let verb = if verdict == RunVerdict::Grows {
             "squeals (still growing)"

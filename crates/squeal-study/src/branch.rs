@@ -26,6 +26,18 @@ pub fn values(lo: f64, hi: f64, n: usize) -> Vec<f64> {
 /// linearisation is finite, and every value acceptable (messages name
 /// `--param`).
 pub fn check(sc: &Scenario, name: &str, values: &[f64]) -> Result<(), StudyError> {
+    if let Some(f) = sc.model.forcing_hz().first() {
+        return Err(InputError(format!(
+            "{}: the model is forced (a harmonic force at {f} Hz): branch follows self-excited orbits by shooting; `squeal hb --param {name}=…` follows a forced response",
+            sc.name
+        ))
+        .into());
+    }
+    check_param(sc, name, values)
+}
+
+/// [`check`] without the refusal of forced models (`hb --param` takes them).
+pub fn check_param(sc: &Scenario, name: &str, values: &[f64]) -> Result<(), StudyError> {
     if sc.model.get(name).is_none() {
         return Err(InputError(format!(
             "--param {name}: unknown parameter for model {}",

@@ -679,10 +679,10 @@ fn finish<M: System<N> + ?Sized, const N: usize>(
     Ok(HbFound {
         harmonics,
         period: o.period(),
-        forcing_hz: forcing_omega(m)
-            .ok()
-            .flatten()
-            .map(|w| w / std::f64::consts::TAU),
+        forcing_hz: match m.forcing_hz().as_slice() {
+            [f] => Some(*f),
+            _ => None,
+        },
         amplitude: real.iter().map(|&i| amp[i]).collect(),
         series: o.fourier.clone(),
         spectrum: o

@@ -71,7 +71,9 @@ fn why_end(e: &HbBranchEnd, hi: f64) -> String {
         HbBranchEnd::Collapsed(p) => {
             format!("the orbit shrank onto steady sliding near {p} (a Hopf point)")
         }
-        HbBranchEnd::Stalled(p, why) => format!("no continuation step converged at {p}: {why}"),
+        HbBranchEnd::Stalled(p, why) => format!(
+            "no continuation step converged at {p}: {why} (where a switch appears on the orbit — grazing, or a contact beginning to stick — the HB residual is not smooth, and stick is not balanced here; `squeal branch` follows the orbit by shooting)"
+        ),
         HbBranchEnd::MaxPoints => "the most points a branch may have".into(),
     }
 }
@@ -90,7 +92,7 @@ pub fn follow(
     opts: &CycleOptions,
     cancel: &Cancel,
 ) -> Result<HbBranchFound, StudyError> {
-    crate::branch::check(sc, name, &[lo, hi])?;
+    crate::branch::check_param(sc, name, &[lo, hi])?;
     crate::hb::check_harmonics(harmonics)?;
     let mut first = sc.clone();
     first

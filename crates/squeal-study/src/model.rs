@@ -90,6 +90,15 @@ impl AnyModel {
             _ => None,
         }
     }
+    /// The frequencies (Hz) of the model's harmonic forces, ascending
+    /// (lumped models' `[[force]]` with `amplitude` and `freq_hz`); empty for
+    /// an autonomous model.
+    pub fn forcing_hz(&self) -> Vec<f64> {
+        match self {
+            AnyModel::Lumped(l) => l.forcing_hz(),
+            _ => Vec::new(),
+        }
+    }
     /// Model name.
     pub fn name(&self) -> &'static str {
         with_model!(self, m => m.name(), lumped _l => "lumped")

@@ -149,3 +149,151 @@ fn hb_from_the_hopf_guess_needs_no_settling() {
     assert!((fh / fc - 1.0).abs() <= 1e-8, "{fh} vs {fc}");
     assert_eq!(hb["stable"], true);
 }
+
+fn lumped(name: &str) -> String {
+    format!(
+        "{}/../../scenarios/lumped/{name}.toml",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
+/// The forced Duffing oscillator: its response at 15 Hz (a linear damped
+/// model's pair of multipliers has |μ| = e^{−cT/2m} exactly, Liouville),
+/// and its frequency-response curve from 10 to 30 Hz through both folds,
+/// the middle branch unstable, with the files of `--out`.
+#[test]
+fn the_duffing_response_and_its_curve_through_both_folds() {
+    let d = tempfile::tempdir().unwrap();
+    let duffing = lumped("duffing");
+    let one = json_of(&squeal(d.path(), &["hb", &duffing, "--json"]));
+    assert_eq!(one["forced"], true);
+    assert_eq!(one["forcing_hz"].as_f64(), Some(15.0));
+    assert!((one["freq_hz"].as_f64().unwrap() - 15.0).abs() < 1e-12);
+    let liouville = (-2.0 / 2.0 / 15.0f64).exp();
+    assert!((one["max_multiplier"].as_f64().unwrap() - liouville).abs() < 1e-6);
+    assert_eq!(one["stable"], true);
+    // Below the resonance the response is unique: HB is the settled run's.
+    let x = one["amplitude"]["x"].as_f64().unwrap();
+    assert!((4e-3..1e-2).contains(&x), "{x}");
+    let out = squeal(
+        d.path(),
+        &[
+            "hb",
+            &duffing,
+            "--param",
+            "shaker.freq_hz=10:30:41",
+            "--json",
+            "--out",
+            "frc",
+        ],
+    );
+    let br = json_of(&out);
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("frc/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary, br);
+    let folds: Vec<f64> = br["folds"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(folds.len(), 2, "{folds:?}");
+    assert!((22.2..22.45).contains(&folds[0]) && (17.1..17.35).contains(&folds[1]));
+    let points = br["points"].as_array().unwrap();
+    // Between the folds, in the order followed: stable, unstable, stable;
+    // the last point at 30 Hz exactly.
+    let stable: Vec<bool> = points.iter().map(|p| p["stable"] == true).collect();
+    let changes = stable.windows(2).filter(|w| w[0] != w[1]).count();
+    assert_eq!(changes, 2, "{stable:?}");
+    assert_eq!(points.last().unwrap()["value"].as_f64(), Some(30.0));
+    let csv = std::fs::read_to_string(d.path().join("frc/branch.csv")).unwrap();
+    assert_eq!(
+        csv.lines().next().unwrap(),
+        "shaker.freq_hz,period,freq_hz,amplitude_x,amplitude_vx,max_multiplier,stable,point"
+    );
+    assert_eq!(csv.lines().count(), points.len() + 1);
+    assert_eq!(csv.matches(",fold").count(), 2);
+    assert!(d.path().join("frc/hb_branch.png").is_file());
+}
+
+/// Den Hartog's Coulomb-damped oscillator (r = 1.5, β = 0.3): the exact
+/// amplitude for motion without stops, `X_st √(1/(1 − r²)² − (βU)²)`, `U =
+/// sin(π/r)/(r(1 + cos(π/r)))`; HB at H = 40 is within its first-order
+/// truncation error (1.4e-3).
+#[test]
+fn den_hartogs_oscillator_through_the_cli() {
+    let d = tempfile::tempdir().unwrap();
+    let v = json_of(&squeal(
+        d.path(),
+        &[
+            "hb",
+            &lumped("coulomb-forced"),
+            "--harmonics",
+            "40",
+            "--json",
+        ],
+    ));
+    let (r, beta, x_st) = (1.5f64, 0.3f64, 1e-3);
+    let pi = std::f64::consts::PI;
+    let u = (pi / r).sin() / (r * (1.0 + (pi / r).cos()));
+    let exact = x_st * (1.0 / (1.0 - r * r).powi(2) - (beta * u).powi(2)).sqrt();
+    let x = v["amplitude"]["x"].as_f64().unwrap();
+    assert!((x / exact - 1.0).abs() < 2e-3, "{x} vs {exact}");
+    assert_eq!(v["contact_modes"]["rub"]["stick"].as_f64(), Some(0.0));
+    assert_eq!(v["switches_per_period"].as_u64(), Some(2));
+}
+
+/// Shooting refuses forced models; hb refuses what does not apply to them.
+#[test]
+fn forced_models_are_refused_where_they_do_not_belong() {
+    let d = tempfile::tempdir().unwrap();
+    let duffing = lumped("duffing");
+    for args in [
+        vec!["cycle", &duffing],
+        vec![
+            "branch",
+            &duffing,
+            "--param",
+            "shaker.freq_hz=10:20:3",
+            "--out",
+            "b",
+        ],
+    ] {
+        let err = refused(&squeal(d.path(), &args));
+        assert!(err.contains("forced") && err.contains("squeal hb"), "{err}");
+    }
+    let err = refused(&squeal(d.path(), &["hb", &duffing, "--guess", "hopf"]));
+    assert!(
+        err.contains("--guess hopf") && err.contains("forced"),
+        "{err}"
+    );
+    let err = refused(&squeal(
+        d.path(),
+        &["hb", &duffing, "--set", "shaker.freq_hz=0"],
+    ));
+    assert!(
+        err.contains("shaker.freq_hz") && err.contains("freq_hz > 0"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 0);
+}
+
+/// A simulated forced run does not call its forced line squeal.
+#[test]
+fn a_forced_run_is_a_response_not_squeal() {
+    let d = tempfile::tempdir().unwrap();
+    let out = crate::cli_common::ok(&squeal(
+        d.path(),
+        &["simulate", &lumped("duffing"), "--out", "r"],
+    ));
+    let first = out.lines().next().unwrap();
+    assert!(
+        first.starts_with("responds at ") && first.contains("not self-excited squeal"),
+        "{first}"
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("r/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(v["squeal"]["forced_hz"].as_f64(), Some(15.0));
+}
