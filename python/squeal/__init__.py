@@ -869,12 +869,15 @@ def hb(
     settle_steps: int = 20_000_000,
     settle_time: float = 1000.0,
     settle_tol: float = 1e-2,
+    param: Optional[Axis] = None,
     out: Optional[PathLike] = None,
     set: Optional[Mapping[str, Any]] = None,
     **params: Any,
 ) -> Dict[str, Any]:
-    """The self-excited periodic orbit by harmonic balance (``squeal hb
-    --json``): ``freq_hz`` (Hz) and ``period`` (s); ``amplitude`` per state
+    """The periodic orbit by harmonic balance (``squeal hb --json``): of a
+    forced model (a ``[[force]]`` with ``amplitude`` and ``freq_hz``) its
+    periodic response at the forcing frequency (``forced``, ``forcing_hz``),
+    else the self-excited orbit. ``freq_hz`` (Hz) and ``period`` (s); ``amplitude`` per state
     (half peak-to-peak, m or m/s); ``harmonics`` per dof (the mean, then
     the amplitude of harmonics 1…H, m); ``contact_modes`` (fraction of the
     period each contact spends in slip+, slip−, stick, free);
@@ -888,7 +891,32 @@ def hb(
     settling only if that finds no stable orbit); the settling options are
     ``cycle``'s. Orbits that stick raise ``ScenarioError``. With ``out``,
     the CLI's files (``hb_orbit.csv``, ``summary.json``, ``hb.png``) are
-    written there."""
+    written there.
+
+    With ``param=(NAME, LO, HI, N)`` (``--param``) the solution is followed
+    from ``NAME = LO`` to ``HI`` by pseudo-arclength continuation through
+    folds, steps of at most ``(HI − LO)/(N − 1)``: a forced model's
+    frequency-response curve with ``"<force>.freq_hz"``. The document then
+    has ``points`` (per point ``value``, ``freq_hz``, ``period``,
+    ``amplitude`` per state, ``max_multiplier``, ``stable``, ``point``:
+    ``step`` or ``fold``), ``folds`` (the parameter at each), ``end``,
+    ``start`` (the document at ``LO``) and ``warnings``; ``out`` gets
+    ``branch.csv``, ``summary.json`` and ``hb_branch.png``."""
+    if param is not None:
+        return dict(
+            json.loads(
+                _squeal.hb_branch(
+                    *_source(scenario),
+                    _sets(set, params),
+                    _axis(param, "param"),
+                    int(harmonics),
+                    int(settle_steps),
+                    float(settle_time),
+                    float(settle_tol),
+                    _out(out),
+                )
+            )
+        )
     return dict(
         json.loads(
             _squeal.hb(

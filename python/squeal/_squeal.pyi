@@ -88,6 +88,17 @@ def hb(
     guess: str,
     out: Optional[str] = None,
 ) -> str: ...
+def hb_branch(
+    kind: str,
+    text: str,
+    sets: List[str],
+    param: Tuple[str, float, float, int],
+    harmonics: int,
+    settle_steps: int,
+    settle_time: float,
+    settle_tol: float,
+    out: Optional[str] = None,
+) -> str: ...
 def validate(filter: Optional[str] = None) -> str: ...
 def inspect(kind: str, text: str, sets: List[str]) -> str: ...
 def reduce(kind: str, text: str, sets: List[str]) -> Dict[str, Any]: ...

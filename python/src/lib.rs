@@ -1183,6 +1183,45 @@ fn hb(
     json_text(&doc)
 }
 
+/// A harmonic-balance solution followed in one parameter (`squeal hb
+/// --param --json`): the document as JSON text.
+#[pyfunction]
+#[pyo3(signature = (kind, text, sets, param, harmonics, settle_steps, settle_time, settle_tol, out=None))]
+#[allow(clippy::too_many_arguments)]
+fn hb_branch(
+    py: Python<'_>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    param: (String, f64, f64, usize),
+    harmonics: usize,
+    settle_steps: u64,
+    settle_time: f64,
+    settle_tol: f64,
+    out: Option<String>,
+) -> PyResult<String> {
+    let sc = resolve(kind, text, &sets)?;
+    let spec = format!("{}={}:{}:{}", param.0, param.1, param.2, param.3);
+    let (name, lo, hi, n) = squeal_study::branch::parse_range(&spec).map_err(input_err)?;
+    squeal_study::hb::check_harmonics(harmonics)
+        .map_err(|e| study_err(squeal_study::StudyError::Input(e)))?;
+    let opts =
+        squeal_study::cycle::checked_options(&sc, settle_steps, settle_time, settle_tol, None)
+            .map_err(study_err)?;
+    let stage = out.as_deref().map(new_stage).transpose()?;
+    let br = compute(py, |cancel| {
+        squeal_study::hb_branch::follow(&sc, &name, lo, hi, n, harmonics, &opts, cancel)
+    })?;
+    let mut doc = br.to_json();
+    doc["scenario"] = sc.to_json();
+    if let Some(stage) = stage {
+        let write = || squeal_files::hb::write_branch(&stage, &br, &sc, &doc);
+        py.allow_threads(write).map_err(run_err)?;
+        commit(py, stage)?;
+    }
+    json_text(&doc)
+}
+
 /// A branch of limit cycles (`squeal branch --json`): the document as JSON
 /// text.
 #[pyfunction]
@@ -1241,6 +1280,7 @@ fn _squeal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(cycle, m)?)?;
     m.add_function(wrap_pyfunction!(hb, m)?)?;
+    m.add_function(wrap_pyfunction!(hb_branch, m)?)?;
     m.add_function(wrap_pyfunction!(branch, m)?)?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add_function(wrap_pyfunction!(inspect, m)?)?;

@@ -356,6 +356,25 @@ def test_hb_equals_cli_json_and_the_shooting_cycle(cli):
         squeal.hb("belt")
 
 
+DUFFING = pathlib.Path(__file__).resolve().parents[2] / "scenarios" / "lumped" / "duffing.toml"
+
+
+def test_hb_forced_response_curve_equals_the_clis(cli, tmp_path):
+    # The forced Duffing oscillator's frequency-response curve through both
+    # folds: the CLI's document, and the files of out=.
+    doc = json.loads(cli("hb", str(DUFFING), "--param", "shaker.freq_hz=10:30:41", "--json"))
+    h = squeal.hb(DUFFING, param=("shaker.freq_hz", 10.0, 30.0, 41), out=tmp_path / "frc")
+    assert h == doc
+    assert h["forced"] is True and len(h["folds"]) == 2
+    assert 22.2 < h["folds"][0] < 22.45 and 17.1 < h["folds"][1] < 17.35
+    assert json.loads((tmp_path / "frc" / "summary.json").read_text()) == h
+    assert (tmp_path / "frc" / "branch.csv").read_text().count(",fold") == 2
+    one = squeal.hb(DUFFING)
+    assert one["forced"] is True and one["forcing_hz"] == 15.0 and one["stable"] is True
+    with pytest.raises(squeal.ScenarioError, match="forced"):
+        squeal.cycle(DUFFING)
+
+
 def test_reproduce_equals_the_clis_table_and_conclusions(cli, tmp_path):
     cli("reproduce", "--duration-scale", "0.5", "--no-figures", "--out", str(tmp_path / "r"))
     r = squeal.reproduce(duration_scale=0.5)
