@@ -41,6 +41,7 @@ __all__ = [
     "critical",
     "cycle",
     "hb",
+    "nma",
     "inspect",
     "listen",
     "map",
@@ -927,6 +928,40 @@ def hb(
                 float(settle_time),
                 float(settle_tol),
                 str(guess),
+                _out(out),
+            )
+        )
+    )
+
+
+def nma(
+    scenario: Scenario,
+    *,
+    modal_amplitude: Tuple[float, float, int],
+    mode: int = 1,
+    harmonics: int = 20,
+    out: Optional[PathLike] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    **params: Any,
+) -> Dict[str, Any]:
+    """A friction-damped nonlinear mode by the extended periodic motion
+    concept (``squeal nma --json``): ``mode`` (numbered from 1 by frequency
+    of the model linearised with its contacts stuck, ``linear_hz`` its
+    frequency in Hz), and per log-spaced mass-normalised modal amplitude
+    (``modal_amplitude=(LO, HI, N)``, m·√kg) the ``points``:
+    ``freq_hz`` (Hz), ``damping_ratio``, ``xi`` (the artificial damping,
+    1/s), ``amplitude`` per state, ``residual``, ``sticks``; ``failures``
+    and ``warnings``. Lumped and matrix models only (the mass matrix). With
+    ``out``, the CLI's files (``nma.csv``, ``summary.json``, ``nma.png``)."""
+    lo, hi, n = modal_amplitude
+    return dict(
+        json.loads(
+            _squeal.nma(
+                *_source(scenario),
+                _sets(set, params),
+                int(mode),
+                (float(lo), float(hi), int(n)),
+                int(harmonics),
                 _out(out),
             )
         )

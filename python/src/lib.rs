@@ -1222,6 +1222,37 @@ fn hb_branch(
     json_text(&doc)
 }
 
+/// A nonlinear mode (`squeal nma --json`): the document as JSON text.
+#[pyfunction]
+#[pyo3(signature = (kind, text, sets, mode, amplitudes, harmonics, out=None))]
+#[allow(clippy::too_many_arguments)]
+fn nma(
+    py: Python<'_>,
+    kind: &str,
+    text: &str,
+    sets: Vec<String>,
+    mode: usize,
+    amplitudes: (f64, f64, usize),
+    harmonics: usize,
+    out: Option<String>,
+) -> PyResult<String> {
+    let sc = resolve(kind, text, &sets)?;
+    let spec = format!("{}:{}:{}", amplitudes.0, amplitudes.1, amplitudes.2);
+    let amps = squeal_study::nma::parse_amplitudes(&spec).map_err(input_err)?;
+    let stage = out.as_deref().map(new_stage).transpose()?;
+    let found = compute(py, |cancel| {
+        squeal_study::nma::of_scenario(&sc, mode, &amps, harmonics, cancel)
+    })?;
+    let mut doc = found.to_json();
+    doc["scenario"] = sc.to_json();
+    if let Some(stage) = stage {
+        let write = || squeal_files::nma::write(&stage, &found, &sc, &doc);
+        py.allow_threads(write).map_err(run_err)?;
+        commit(py, stage)?;
+    }
+    json_text(&doc)
+}
+
 /// A branch of limit cycles (`squeal branch --json`): the document as JSON
 /// text.
 #[pyfunction]
@@ -1281,6 +1312,7 @@ fn _squeal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(cycle, m)?)?;
     m.add_function(wrap_pyfunction!(hb, m)?)?;
     m.add_function(wrap_pyfunction!(hb_branch, m)?)?;
+    m.add_function(wrap_pyfunction!(nma, m)?)?;
     m.add_function(wrap_pyfunction!(branch, m)?)?;
     m.add_function(wrap_pyfunction!(validate, m)?)?;
     m.add_function(wrap_pyfunction!(inspect, m)?)?;

@@ -375,6 +375,17 @@ def test_hb_forced_response_curve_equals_the_clis(cli, tmp_path):
         squeal.cycle(DUFFING)
 
 
+def test_nma_equals_the_clis(cli, tmp_path):
+    damper = DUFFING.parent / "friction-damper.toml"
+    doc = json.loads(cli("nma", str(damper), "--modal-amplitude", "1e-4:1:7", "--json"))
+    n = squeal.nma(damper, modal_amplitude=(1e-4, 1.0, 7), out=tmp_path / "n")
+    assert n == doc
+    assert len(n["points"]) == 7 and n["mode"] == 1
+    assert (tmp_path / "n" / "nma.csv").read_text().count("\n") == 8
+    with pytest.raises(squeal.ScenarioError, match="lumped"):
+        squeal.nma("hoffmann", modal_amplitude=(1e-3, 1e-2, 3))
+
+
 def test_reproduce_equals_the_clis_table_and_conclusions(cli, tmp_path):
     cli("reproduce", "--duration-scale", "0.5", "--no-figures", "--out", str(tmp_path / "r"))
     r = squeal.reproduce(duration_scale=0.5)

@@ -36,6 +36,7 @@ pub mod hb;
 pub mod map;
 pub mod merge;
 pub mod modes;
+pub mod nma;
 pub mod output;
 pub mod reduce;
 pub mod reproduce;

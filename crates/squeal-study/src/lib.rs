@@ -26,6 +26,7 @@ pub mod map;
 pub mod matrix_file;
 pub mod memory;
 pub mod model;
+pub mod nma;
 pub mod plan;
 pub mod radiation;
 pub mod reduce;

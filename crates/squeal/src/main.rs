@@ -60,6 +60,8 @@ enum Command {
     Cycle(commands::cycle::CycleArgs),
     /// The self-excited periodic orbit by harmonic balance: frequency, harmonics, convergence, Floquet multipliers.
     Hb(commands::hb::HbArgs),
+    /// A friction-damped mode's amplitude-dependent frequency and damping (extended periodic motion concept, harmonic balance).
+    Nma(commands::nma::NmaArgs),
     /// Follow the limit cycle in one parameter: branch.csv, bifurcations, diagram.
     Branch(commands::branch::BranchArgs),
     /// Every eigenvalue along a one-parameter sweep, modes tracked: sweep.csv and the mode-coupling diagram.
@@ -155,6 +157,7 @@ fn dispatch(command: Command) -> Result<(), RunError> {
         Command::Cycle(a) => commands::cycle::run(a),
         Command::Branch(a) => commands::branch::run(a),
         Command::Hb(a) => commands::hb::run(a),
+        Command::Nma(a) => commands::nma::run(a),
     }
 }
 

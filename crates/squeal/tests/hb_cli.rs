@@ -297,3 +297,57 @@ fn a_forced_run_is_a_response_not_squeal() {
             .unwrap();
     assert_eq!(v["squeal"]["forced_hz"].as_f64(), Some(15.0));
 }
+
+/// The friction damper's nonlinear mode: the stuck mode at low amplitude
+/// (x1 alone on k1 + k2: √(2·10⁴)/2π Hz, its damping the springs' c = 0.2
+/// kg/s through φᵀCφ), the freely sliding chain's out-of-phase mode at
+/// high amplitude (√((3+√5)/2·10⁴)/2π Hz), and friction's damping peak
+/// between; the files of `--out`; refusals.
+#[test]
+fn the_friction_dampers_nonlinear_mode() {
+    let d = tempfile::tempdir().unwrap();
+    let sc = lumped("friction-damper");
+    let v = json_of(&squeal(
+        d.path(),
+        &[
+            "nma",
+            &sc,
+            "--mode",
+            "1",
+            "--modal-amplitude",
+            "1e-4:1:13",
+            "--json",
+            "--out",
+            "n",
+        ],
+    ));
+    let tau = std::f64::consts::TAU;
+    let stuck = 2e4f64.sqrt() / tau;
+    assert!((v["linear_hz"].as_f64().unwrap() / stuck - 1.0).abs() < 1e-9);
+    let pts = v["points"].as_array().unwrap();
+    assert_eq!(pts.len(), 13, "{}", v["failures"]);
+    let f = |i: usize, k: &str| pts[i][k].as_f64().unwrap();
+    assert!((f(0, "freq_hz") / stuck - 1.0).abs() < 1e-5);
+    let sliding = ((3.0 + 5f64.sqrt()) / 2.0 * 1e4).sqrt() / tau;
+    assert!((f(12, "freq_hz") / sliding - 1.0).abs() < 1e-4);
+    // The stuck mode's damping: x1 on the springs' c1 + c2 = 0.4 kg/s, and
+    // the tanh damper's slope c_f = μN/ε = 10⁵ kg/s holding x2 almost still
+    // (|x2| = k2|x1|/(c_f ω)), which dissipates as a dashpot k2²/(c_f ω²) =
+    // 0.05 kg/s on x1: D = 0.45/(2ω).
+    let w = stuck * tau;
+    let d0 = (0.4 + 1e8 / (1e5 * w * w)) / (2.0 * w);
+    assert!((f(0, "damping_ratio") / d0 - 1.0).abs() < 1e-3, "{}", f(0, "damping_ratio"));
+    let peak = (0..13).map(|i| f(i, "damping_ratio")).fold(0.0, f64::max);
+    assert!(peak > 20.0 * d0, "{peak}");
+    let csv = std::fs::read_to_string(d.path().join("n/nma.csv")).unwrap();
+    assert!(csv.starts_with("modal_amplitude,freq_hz,xi,damping_ratio,amplitude_x1,"));
+    assert!(d.path().join("n/nma.png").is_file());
+    for (args, want) in [
+        (vec!["nma", "hoffmann", "--modal-amplitude", "1e-3:1e-2:3"], "lumped"),
+        (vec!["nma", &sc, "--mode", "3", "--modal-amplitude", "1e-3:1e-2:3"], "--mode 3"),
+        (vec!["nma", &sc, "--modal-amplitude", "0:1:3"], "--modal-amplitude"),
+    ] {
+        let err = refused(&squeal(d.path(), &args));
+        assert!(err.contains(want), "{err}");
+    }
+}

@@ -124,6 +124,7 @@ pub fn hb_branch<const N: usize>(
             scale: forced_scales(&f0, 1.0),
             omega0: f0.omega,
             phase_dof: None,
+            mode: None,
         }
     } else {
         let amp = harmonic_amplitudes(&f0);
@@ -141,6 +142,7 @@ pub fn hb_branch<const N: usize>(
             scale: amp.iter().map(|a| a.max(1e-6 * top)).collect(),
             omega0: f0.omega,
             phase_dof: Some(phase_dof),
+            mode: None,
         }
     };
     let m = lay.unknowns();

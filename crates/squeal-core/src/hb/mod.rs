@@ -45,6 +45,7 @@
 //! (alternating frequency–time).
 
 mod continuation;
+pub mod nma;
 
 pub use continuation::{hb_branch, HbBranch, HbBranchEnd, HbBranchOptions, HbPoint};
 
@@ -356,6 +357,10 @@ pub(crate) struct Layout {
     /// Autonomous: the dof whose `b₁` is zero (the phase condition), and ω
     /// is an unknown. Forced (`None`): ω is the forcing's.
     pub(crate) phase_dof: Option<usize>,
+    /// A nonlinear mode (extended periodic motion concept): the artificial
+    /// damping `ξ` is one more unknown, and the phase and amplitude
+    /// conditions are the mode's ([`nma`]).
+    pub(crate) mode: Option<nma::ModeNorm>,
 }
 
 impl Layout {
@@ -365,7 +370,9 @@ impl Layout {
 
     /// Unknowns (and equations): the coefficients, and ω if autonomous.
     pub(crate) fn unknowns(&self) -> usize {
-        self.n * self.width() + usize::from(self.phase_dof.is_some())
+        self.n * self.width()
+            + usize::from(self.phase_dof.is_some())
+            + usize::from(self.mode.is_some())
     }
 
     /// `x` of the series `f`.
@@ -532,7 +539,7 @@ impl<'a, S: System<N> + ?Sized, const N: usize> Balance<'a, S, N> {
 
     /// The projections `(1/π)∫ a_i basis_c dθ` (mean: `1/2π`) of the
     /// accelerations over `pieces`.
-    fn project(&self, f: &Fourier, pieces: &[Piece], proj: &mut [f64]) {
+    fn project(&self, f: &Fourier, pieces: &[Piece], xi: f64, proj: &mut [f64]) {
         let (n, h, w) = (self.lay.n, self.lay.h, self.lay.width());
         proj.fill(0.0);
         let mut dz = [0.0; N];
@@ -555,7 +562,9 @@ impl<'a, S: System<N> + ?Sized, const N: usize> Balance<'a, S, N> {
                     cs[k] = (c * c1 - s * s1, s * c1 + c * s1);
                 }
                 for i in 0..n {
-                    let acc = dz[N / 2 + i] * wt;
+                    // The extended periodic motion concept's negative
+                    // damping ξ M q̇, as an acceleration: + ξ q̇.
+                    let acc = (dz[N / 2 + i] + xi * z[N / 2 + i]) * wt;
                     let row = &mut proj[i * w..(i + 1) * w];
                     row[0] += acc / std::f64::consts::TAU;
                     for k in 1..=h {
@@ -574,7 +583,11 @@ impl<'a, S: System<N> + ?Sized, const N: usize> Balance<'a, S, N> {
         let lay = self.lay;
         let (n, h, w) = (lay.n, lay.h, lay.width());
         let mut proj = vec![0.0; n * w];
-        self.project(&f, &pieces, &mut proj);
+        let xi = match lay.mode {
+            Some(_) => x[n * w + 1] * lay.omega0,
+            None => 0.0,
+        };
+        self.project(&f, &pieces, xi, &mut proj);
         let om2 = f.omega * f.omega;
         let norm = lay.omega0 * lay.omega0;
         for i in 0..n {
@@ -588,7 +601,11 @@ impl<'a, S: System<N> + ?Sized, const N: usize> Balance<'a, S, N> {
                 }
             }
         }
-        if let Some(d) = lay.phase_dof {
+        if let Some(mn) = &lay.mode {
+            let (phase, amplitude) = mn.conditions(&f);
+            out[n * w] = phase;
+            out[n * w + 1] = amplitude;
+        } else if let Some(d) = lay.phase_dof {
             out[n * w] = x[d * w + 2];
         }
     }
@@ -861,6 +878,7 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
         scale: amp.iter().map(|a| a.max(1e-6 * top)).collect(),
         omega0: guess.omega,
         phase_dof: Some(phase_dof),
+        mode: None,
     };
     let bal = Balance::<S, N>::new(sys, &lay)?;
     let m = lay.unknowns();
@@ -931,6 +949,7 @@ pub fn forced_response<S: System<N> + ?Sized, const N: usize>(
         scale: forced_scales(&guess, 1.0),
         omega0: omega,
         phase_dof: None,
+        mode: None,
     };
     let bal = Balance::<S, N>::new(sys, &lay)?;
     let res = |x: &[f64], out: &mut [f64]| bal.residual(x, out);

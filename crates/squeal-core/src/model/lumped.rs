@@ -466,6 +466,7 @@ mod spec;
 mod specs;
 mod steady;
 mod system;
+pub use linearised::StuckModes;
 pub use padding::{embed, padded_dofs, padded_solver, real_states, MAX_EXACT_DOFS, PADDED_DOFS};
 use params::prefixed;
 pub use sparse::{Sparse, Triplets};

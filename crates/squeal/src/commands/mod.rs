@@ -8,6 +8,7 @@ pub mod inspect;
 pub mod listen;
 pub mod map;
 pub mod merge;
+pub mod nma;
 pub mod plot;
 pub mod reduce;
 pub mod reproduce;

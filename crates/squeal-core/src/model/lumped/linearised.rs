@@ -227,3 +227,97 @@ impl Lumped {
             .expect("the model's indices are within its dofs")
     }
 }
+
+impl Lumped {
+    /// The undamped modes of the model linearised at the static state `z`
+    /// with its contacts stuck: the structure (springs, `K`, the cubic
+    /// springs' tangent stiffness) plus the normal stiffness `k n nᵀ` of each
+    /// closed elastic contact, constrained by `t_i·q = 0` for every closed
+    /// contact (a stuck contact's tangent does not move). Returns the mass
+    /// matrix and the modes `(ω, φ)`, ascending in `ω` (rad/s), `φ` mass
+    /// normalised (`φᵀMφ = 1`); the low-amplitude limit of a friction-damped
+    /// mode (docs/physics.md §5j). Rigid-body modes have `ω = 0`.
+    pub fn stuck_modes(&self, z: &[f64]) -> Result<StuckModes, String> {
+        let n = self.dofs.len();
+        let (q, u) = z.split_at(n);
+        let free = Modes::all(self.contacts.len(), Mode::Free);
+        let jf = self.force_jacobian(&free, z);
+        let mut k: DMatrix<f64> = -jf.columns(0, n);
+        let mut rows: Vec<Vec<f64>> = Vec::new();
+        for c in &self.contacts {
+            let closed = match &c.normal {
+                Normal::Prescribed(_) => true,
+                Normal::Elastic {
+                    normal,
+                    k: kn,
+                    bilateral,
+                    ..
+                } => {
+                    let on = *bilateral || c.normal_force(q, u) > 0.0;
+                    if on {
+                        for (a, ca) in normal.idx.iter().zip(&normal.coef) {
+                            for (b, cb) in normal.idx.iter().zip(&normal.coef) {
+                                k[(*a, *b)] += kn * ca * cb;
+                            }
+                        }
+                    }
+                    on
+                }
+            };
+            if closed {
+                let mut r = vec![0.0; n];
+                c.tangent.add_scaled(&mut r, 1.0);
+                rows.push(r);
+            }
+        }
+        let so = self.second_order_dyn(z);
+        let m = so.m;
+        // T: an orthonormal basis of the constraints' null space.
+        let t = if rows.is_empty() {
+            DMatrix::<f64>::identity(n, n)
+        } else {
+            let g = DMatrix::from_fn(rows.len(), n, |i, j| rows[i][j]);
+            let svd = (g.transpose() * &g).symmetric_eigen();
+            let top = svd.eigenvalues.iter().cloned().fold(0.0, f64::max);
+            let keep: Vec<usize> = (0..n)
+                .filter(|&i| svd.eigenvalues[i] <= 1e-12 * top)
+                .collect();
+            DMatrix::from_fn(n, keep.len(), |i, j| svd.eigenvectors[(i, keep[j])])
+        };
+        let r = t.ncols();
+        if r == 0 {
+            return Err("with every contact stuck no dof can move (no mode)".into());
+        }
+        let ksym = 0.5 * (&k + k.transpose());
+        let mr = t.transpose() * &m * &t;
+        let kr = t.transpose() * &ksym * &t;
+        let l = mr
+            .clone()
+            .cholesky()
+            .ok_or("the mass matrix is not positive definite")?;
+        let linv = l.l().try_inverse().ok_or("the mass matrix is singular")?;
+        let a = &linv * kr * linv.transpose();
+        let eig = (0.5 * (&a + a.transpose())).symmetric_eigen();
+        let mut order: Vec<usize> = (0..r).collect();
+        order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+        let modes = order
+            .into_iter()
+            .map(|i| {
+                let w2 = eig.eigenvalues[i].max(0.0);
+                let y = linv.transpose() * eig.eigenvectors.column(i);
+                let phi = &t * y;
+                (w2.sqrt(), phi.iter().copied().collect())
+            })
+            .collect();
+        Ok(StuckModes { mass: m, modes })
+    }
+}
+
+/// What [`Lumped::stuck_modes`] returns.
+#[derive(Debug, Clone)]
+pub struct StuckModes {
+    /// The mass matrix `M` (n × n).
+    pub mass: DMatrix<f64>,
+    /// `(ω (rad/s), φ)` ascending, `φᵀMφ = 1`.
+    pub modes: Vec<(f64, Vec<f64>)>,
+}
