@@ -8,9 +8,8 @@
 //! every HB orbit is the independent check that it is periodic.
 
 use squeal_core::cycle::{self, CycleOptions};
-use squeal_core::hb::{
-    forced_response, hb_branch, Fourier, HbBranchEnd, HbBranchOptions, HbOptions,
-};
+use squeal_core::hb::continuation::{hb_branch, HbBranchEnd, HbBranchOptions};
+use squeal_core::hb::{forced_response, Fourier, HbOptions};
 use squeal_core::model::lumped::{ContactSpec, Fixed, ForceSpec, LumpedSpec, SpringSpec};
 use squeal_core::{FrictionLaw, Lumped, System};
 use std::f64::consts::{PI, TAU};

@@ -16,7 +16,8 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 use squeal_core::cycle::continuation::{Reparametrise, Varied};
 use squeal_core::cycle::{self, CycleOptions};
-use squeal_core::hb::{hb_branch, HbBranchEnd, HbBranchOptions, HbError, HbOptions};
+use squeal_core::hb::continuation::{hb_branch, HbBranchEnd, HbBranchOptions};
+use squeal_core::hb::{HbError, HbOptions};
 use squeal_core::System;
 
 /// One point of an HB branch.

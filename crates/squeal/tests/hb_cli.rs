@@ -336,16 +336,36 @@ fn the_friction_dampers_nonlinear_mode() {
     // 0.05 kg/s on x1: D = 0.45/(2ω).
     let w = stuck * tau;
     let d0 = (0.4 + 1e8 / (1e5 * w * w)) / (2.0 * w);
-    assert!((f(0, "damping_ratio") / d0 - 1.0).abs() < 1e-3, "{}", f(0, "damping_ratio"));
+    assert!(
+        (f(0, "damping_ratio") / d0 - 1.0).abs() < 1e-3,
+        "{}",
+        f(0, "damping_ratio")
+    );
     let peak = (0..13).map(|i| f(i, "damping_ratio")).fold(0.0, f64::max);
     assert!(peak > 20.0 * d0, "{peak}");
     let csv = std::fs::read_to_string(d.path().join("n/nma.csv")).unwrap();
     assert!(csv.starts_with("modal_amplitude,freq_hz,xi,damping_ratio,amplitude_x1,"));
     assert!(d.path().join("n/nma.png").is_file());
     for (args, want) in [
-        (vec!["nma", "hoffmann", "--modal-amplitude", "1e-3:1e-2:3"], "lumped"),
-        (vec!["nma", &sc, "--mode", "3", "--modal-amplitude", "1e-3:1e-2:3"], "--mode 3"),
-        (vec!["nma", &sc, "--modal-amplitude", "0:1:3"], "--modal-amplitude"),
+        (
+            vec!["nma", "hoffmann", "--modal-amplitude", "1e-3:1e-2:3"],
+            "lumped",
+        ),
+        (
+            vec![
+                "nma",
+                &sc,
+                "--mode",
+                "3",
+                "--modal-amplitude",
+                "1e-3:1e-2:3",
+            ],
+            "--mode 3",
+        ),
+        (
+            vec!["nma", &sc, "--modal-amplitude", "0:1:3"],
+            "--modal-amplitude",
+        ),
     ] {
         let err = refused(&squeal(d.path(), &args));
         assert!(err.contains(want), "{err}");

@@ -44,10 +44,8 @@
 //! phase condition); Cameron & Griffin, J. Appl. Mech. 56 (1989) 149–154
 //! (alternating frequency–time).
 
-mod continuation;
+pub mod continuation;
 pub mod nma;
-
-pub use continuation::{hb_branch, HbBranch, HbBranchEnd, HbBranchOptions, HbPoint};
 
 use crate::cycle::{autonomous_from, real_indices};
 use crate::model::{Mode, Modes, System};
@@ -360,7 +358,7 @@ pub(crate) struct Layout {
     /// A nonlinear mode (extended periodic motion concept): the artificial
     /// damping `ξ` is one more unknown, and the phase and amplitude
     /// conditions are the mode's ([`nma`]).
-    pub(crate) mode: Option<nma::ModeNorm>,
+    pub(crate) mode: Option<ModeNorm>,
 }
 
 impl Layout {
@@ -403,6 +401,38 @@ impl Layout {
                 .map(|i| (0..w).map(|c| x[i * w + c] * self.scale[i]).collect())
                 .collect(),
         }
+    }
+}
+
+/// The phase and amplitude conditions of a nonlinear mode (module `nma`).
+#[derive(Debug, Clone)]
+pub(crate) struct ModeNorm {
+    /// The mass matrix.
+    pub(crate) mass: DMatrix<f64>,
+    /// `M φ`.
+    pub(crate) m_phi: Vec<f64>,
+    /// The prescribed amplitude `A`.
+    pub(crate) amplitude: f64,
+}
+
+impl ModeNorm {
+    /// The scaled residuals `(φᵀ M b₁ / A, (a₁ᵀ M a₁ + b₁ᵀ M b₁)/A² − 1)`.
+    pub(crate) fn conditions(&self, f: &Fourier) -> (f64, f64) {
+        let n = f.coeffs.len();
+        let a = |i: usize| f.coeffs[i][1];
+        let b = |i: usize| f.coeffs[i][2];
+        let phase: f64 = (0..n).map(|i| self.m_phi[i] * b(i)).sum();
+        let mut norm = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let mij = self.mass[(i, j)];
+                if mij != 0.0 {
+                    norm += mij * (a(i) * a(j) + b(i) * b(j));
+                }
+            }
+        }
+        let a2 = self.amplitude * self.amplitude;
+        (phase / self.amplitude, norm / a2 - 1.0)
     }
 }
 

@@ -21,41 +21,9 @@
 
 use super::{
     checked_guess, fd_jacobian, forcing_omega, harmonic_amplitudes, newton, Balance, Fourier,
-    HbError, HbOptions, HbOrbit, Layout,
+    HbError, HbOptions, HbOrbit, Layout, ModeNorm,
 };
 use nalgebra::DMatrix;
-
-/// The mode's phase and amplitude conditions.
-#[derive(Debug, Clone)]
-pub(crate) struct ModeNorm {
-    /// The mass matrix.
-    mass: DMatrix<f64>,
-    /// `M φ`.
-    m_phi: Vec<f64>,
-    /// The prescribed amplitude `A`.
-    amplitude: f64,
-}
-
-impl ModeNorm {
-    /// The scaled residuals `(φᵀ M b₁ / A, (a₁ᵀ M a₁ + b₁ᵀ M b₁)/A² − 1)`.
-    pub(crate) fn conditions(&self, f: &Fourier) -> (f64, f64) {
-        let n = f.coeffs.len();
-        let a = |i: usize| f.coeffs[i][1];
-        let b = |i: usize| f.coeffs[i][2];
-        let phase: f64 = (0..n).map(|i| self.m_phi[i] * b(i)).sum();
-        let mut norm = 0.0;
-        for i in 0..n {
-            for j in 0..n {
-                let mij = self.mass[(i, j)];
-                if mij != 0.0 {
-                    norm += mij * (a(i) * a(j) + b(i) * b(j));
-                }
-            }
-        }
-        let a2 = self.amplitude * self.amplitude;
-        (phase / self.amplitude, norm / a2 - 1.0)
-    }
-}
 
 /// A point of a nonlinear mode.
 #[derive(Debug, Clone)]
