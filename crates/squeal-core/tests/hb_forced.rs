@@ -14,8 +14,17 @@ use squeal_core::model::lumped::{ContactSpec, Fixed, ForceSpec, LumpedSpec, Spri
 use squeal_core::{FrictionLaw, Lumped, System};
 use std::f64::consts::{PI, TAU};
 
-/// `m ẍ + c ẋ + k x + k3 x³ (+ Coulomb friction μN) = F cos 2πf t`, one dof.
-fn oscillator(m: f64, k: f64, c: f64, k3: f64, f: f64, hz: f64, friction: Option<f64>) -> Lumped {
+/// `m ẍ + c ẋ + k x + k3 x³ (+ Coulomb friction μN) = F cos 2πf t`, one dof
+/// (`F = 0`: no harmonic force).
+pub(crate) fn oscillator(
+    m: f64,
+    k: f64,
+    c: f64,
+    k3: f64,
+    f: f64,
+    hz: f64,
+    friction: Option<f64>,
+) -> Lumped {
     let x = || vec![("x".to_string(), 1.0)];
     let spec = LumpedSpec {
         dofs: vec!["x".into()],

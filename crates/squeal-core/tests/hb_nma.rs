@@ -6,44 +6,12 @@
 
 use squeal_core::hb::nma::{mode_guess, nonlinear_mode};
 use squeal_core::hb::{Fourier, HbOptions};
-use squeal_core::model::lumped::{ContactSpec, Fixed, LumpedSpec, SpringSpec};
-use squeal_core::{FrictionLaw, Lumped};
+use squeal_core::model::lumped::Fixed;
+use squeal_core::Lumped;
 use std::f64::consts::{PI, TAU};
 
 fn one_dof(m: f64, k: f64, c: f64, k3: f64, friction: Option<f64>) -> Lumped {
-    let x = || vec![("x".to_string(), 1.0)];
-    let spec = LumpedSpec {
-        dofs: vec!["x".into()],
-        masses: vec![("x".into(), m)],
-        springs: vec![SpringSpec {
-            name: "spring".into(),
-            on: x(),
-            k,
-            c,
-            k3,
-        }],
-        contacts: friction
-            .map(|ff| ContactSpec {
-                name: "rub".into(),
-                normal: None,
-                k: None,
-                c: None,
-                bilateral: false,
-                normal_force: Some(ff),
-                tangent: Some(x()),
-                v: 0.0,
-                friction: FrictionLaw::Coulomb {
-                    mu_s: 1.0,
-                    mu_k: 1.0,
-                },
-                alpha: 0.0,
-                slope: Vec::new(),
-            })
-            .into_iter()
-            .collect(),
-        ..LumpedSpec::default()
-    };
-    Lumped::build(&spec).unwrap_or_else(|e| panic!("{e}"))
+    crate::hb_forced::oscillator(m, k, c, k3, 0.0, 0.0, friction)
 }
 
 fn opts(h: usize) -> HbOptions {

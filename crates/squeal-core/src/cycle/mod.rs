@@ -375,17 +375,15 @@ pub fn refuse_forced<S: System<N> + ?Sized, const N: usize>(sys: &S) -> Result<(
     )))
 }
 
-/// The Floquet multipliers of a periodic response of a forced model: the
-/// eigenvalues of the monodromy over one forcing period `period` from `z0`
-/// at [`autonomous_from`] (variational equations and saltation matrices, as
-/// for [`floquet_from`]); none is trivial. Returns the multipliers (largest
-/// first), the scaled defect `|φ_T(z₀) − z₀|` and the events per period.
-pub fn forced_floquet<S: System<N> + ?Sized, const N: usize>(
+/// One period from `z0` with the variational equations, in the block scales
+/// of a first plain period's amplitudes; the scales and the scaled defect
+/// `|φ_T(z₀) − z₀|`.
+fn scaled_period<S: System<N> + ?Sized, const N: usize>(
     sys: &S,
     z0: &[f64; N],
     period: f64,
     opts: &CycleOptions,
-) -> Result<(Vec<Multiplier>, f64, [u64; 5]), CycleError> {
+) -> Result<(Period<N>, [f64; N], f64), CycleError> {
     if !(period > 0.0 && period.is_finite()) {
         return Err(CycleError::Bad(format!("period {period}")));
     }
@@ -399,6 +397,21 @@ pub fn forced_floquet<S: System<N> + ?Sized, const N: usize>(
     let defect = (0..N)
         .map(|i| ((p.z_end[i] - z0[i]) / s[i]).abs())
         .fold(0.0, f64::max);
+    Ok((p, s, defect))
+}
+
+/// The Floquet multipliers of a periodic response of a forced model: the
+/// eigenvalues of the monodromy over one forcing period `period` from `z0`
+/// at [`autonomous_from`] (variational equations and saltation matrices, as
+/// for [`floquet_from`]); none is trivial. Returns the multipliers (largest
+/// first), the scaled defect `|φ_T(z₀) − z₀|` and the events per period.
+pub fn forced_floquet<S: System<N> + ?Sized, const N: usize>(
+    sys: &S,
+    z0: &[f64; N],
+    period: f64,
+    opts: &CycleOptions,
+) -> Result<(Vec<Multiplier>, f64, [u64; 5]), CycleError> {
+    let (p, _, defect) = scaled_period(sys, z0, period, opts)?;
     let mut list = eigen_multipliers(&p.m);
     sort_multipliers(&mut list);
     Ok((list, defect, p.events))
@@ -1265,19 +1278,7 @@ pub fn floquet_from<S: System<N> + ?Sized, const N: usize>(
     period: f64,
     opts: &CycleOptions,
 ) -> Result<Cycle<N>, CycleError> {
-    if !(period > 0.0 && period.is_finite()) {
-        return Err(CycleError::Bad(format!("period {period}")));
-    }
-    let first = period_flow(sys, z0, period, &[1.0; N], opts, false, None)?;
-    let mut amp = [0.0; N];
-    for i in 0..N {
-        amp[i] = 0.5 * (first.hi[i] - first.lo[i]);
-    }
-    let s = block_scales(&amp, &opts.solver);
-    let p = period_flow(sys, z0, period, &s, opts, true, None)?;
-    let defect = (0..N)
-        .map(|i| ((p.z_end[i] - z0[i]) / s[i]).abs())
-        .fold(0.0, f64::max);
+    let (p, s, defect) = scaled_period(sys, z0, period, opts)?;
     let t_a = autonomous_from(sys);
     let mut f = [0.0; N];
     let modes = sys.start_modes(t_a, z0);

@@ -70,18 +70,7 @@ pub fn run(a: HbArgs) -> Result<(), RunError> {
             squeal_files::hb::write_branch(&stage, &br, &sc, &doc)?;
             stage.commit()?;
         }
-        if a.json {
-            crate::outln!(
-                "{}",
-                serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
-            );
-        } else {
-            print_branch(&br, &sc);
-            if let Some(d) = &a.out {
-                crate::outln!("output: {}", d.display());
-            }
-        }
-        return Ok(());
+        return report(a.json, &doc, a.out.as_deref(), || print_branch(&br, &sc));
     }
     let stage = a.out.as_deref().map(Staging::new).transpose()?;
     let found = of_scenario(&sc, a.harmonics, &opts, guess, a.out.is_some(), &NEVER)?;
@@ -91,14 +80,25 @@ pub fn run(a: HbArgs) -> Result<(), RunError> {
         squeal_files::hb::write(&stage, &found, &sc, &doc)?;
         stage.commit()?;
     }
-    if a.json {
+    report(a.json, &doc, a.out.as_deref(), || print_human(&found, &sc))
+}
+
+/// The document on stdout (`--json`), or the terminal's lines and the
+/// output folder.
+pub(crate) fn report(
+    json: bool,
+    doc: &serde_json::Value,
+    out: Option<&std::path::Path>,
+    human: impl FnOnce(),
+) -> Result<(), RunError> {
+    if json {
         crate::outln!(
             "{}",
-            serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
+            serde_json::to_string_pretty(doc).map_err(|e| RunError::Io(e.to_string()))?
         );
     } else {
-        print_human(&found, &sc);
-        if let Some(d) = &a.out {
+        human();
+        if let Some(d) = out {
             crate::outln!("output: {}", d.display());
         }
     }

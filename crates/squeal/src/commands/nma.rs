@@ -45,18 +45,7 @@ pub fn run(a: NmaArgs) -> Result<(), RunError> {
         squeal_files::nma::write(&stage, &found, &sc, &doc)?;
         stage.commit()?;
     }
-    if a.json {
-        crate::outln!(
-            "{}",
-            serde_json::to_string_pretty(&doc).map_err(|e| RunError::Io(e.to_string()))?
-        );
-    } else {
-        print_human(&found, &sc);
-        if let Some(d) = &a.out {
-            crate::outln!("output: {}", d.display());
-        }
-    }
-    Ok(())
+    crate::commands::hb::report(a.json, &doc, a.out.as_deref(), || print_human(&found, &sc))
 }
 
 fn print_human(f: &NmaFound, sc: &Scenario) {
