@@ -42,7 +42,7 @@ fn draw_set(
     let d = dir.join(format!("set{id:02}"));
     std::fs::create_dir_all(&d)
         .map_err(|e| RunError::Io(format!("cannot create {}: {e}", d.display())))?;
-    let words = answer.squeal.as_ref().map(|s| s.words());
+    let words = answer.words();
     analysis::draw(
         run,
         an,

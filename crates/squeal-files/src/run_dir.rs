@@ -69,7 +69,7 @@ pub fn write_run(
     if f.plots {
         let squeal_hz = answer.squeal.as_ref().map(|s| s.frequency_hz);
         let band = f.plot.around_squeal(squeal_hz, run.sample_rate);
-        let words = answer.squeal.as_ref().map(|s| s.words());
+        let words = answer.words();
         let explicit = !f.signals.is_empty();
         let (name, dir) = (&sc.name, stage.dir());
         let drawn = analysis::draw(
@@ -143,10 +143,11 @@ pub fn redraw(
     let plot = plot.around_squeal(summary["squeal"]["frequency_hz"].as_f64(), run.sample_rate);
     let q = &summary["squeal"];
     let words = q["frequency_hz"].as_f64().map(|f| {
-        squeal_study::answer::squeal_words(
+        squeal_study::answer::line_words(
             f,
             q["uncertainty_hz"].as_f64(),
             q["source"].as_str().unwrap_or("run"),
+            q["forced_hz"].as_f64(),
         )
     });
     let note = crate::analysis::draw(

@@ -190,6 +190,25 @@ pub fn squeal_words(frequency_hz: f64, uncertainty_hz: Option<f64>, source: &str
     }
 }
 
+/// [`squeal_words`], or for a forced model's line (`forced`: the forcing
+/// frequency it is a multiple of) "forced response 15.000 Hz ± 500 mHz".
+pub fn line_words(
+    frequency_hz: f64,
+    uncertainty_hz: Option<f64>,
+    source: &str,
+    forced: Option<f64>,
+) -> String {
+    match (forced, uncertainty_hz) {
+        (Some(_), Some(u)) => format!(
+            "forced response {} ± {}",
+            si(frequency_hz, "Hz", 5),
+            si(u, "Hz", 2)
+        ),
+        (Some(_), None) => format!("forced response {}", si(frequency_hz, "Hz", 5)),
+        (None, _) => squeal_words(frequency_hz, uncertainty_hz, source),
+    }
+}
+
 impl SquealAnswer {
     /// [`squeal_words`] of this answer.
     pub fn words(&self) -> String {
@@ -347,6 +366,18 @@ impl Answer {
             .filter(|s| s.source == Source::Run)
             .and_then(|s| forcing_match(&sc.model, s.frequency_hz, s.uncertainty_hz));
         answer
+    }
+
+    /// The line in a few words for the pictures' titles ([`line_words`]).
+    pub fn words(&self) -> Option<String> {
+        self.squeal.as_ref().map(|s| {
+            line_words(
+                s.frequency_hz,
+                s.uncertainty_hz,
+                s.source.as_str(),
+                self.forced_hz,
+            )
+        })
     }
 
     /// The run's verdict: the judge's, or `grows` where the answer knows better.
