@@ -224,7 +224,168 @@ pub fn specs() -> Vec<Spec> {
             tolerance: 1e-3,
             compute: || disc_pad_cycle().map(|c| (c.decay_ref, c.decay)),
         },
+        Spec {
+            name: "duffing-backbone-nma",
+            kind: Kind::Analytic,
+            quantity: "frequency of the nonlinear mode (extended periodic motion concept, HB \
+                       H = 16) of ẍ + αẋ + ω₀²x + βx³ = 0 (C = αM: ξ = α leaves the free \
+                       oscillation) at modal amplitude 0.06, 24 % above ω₀",
+            unit: "Hz",
+            source: "the free Duffing oscillator's exact frequency ω = πω₀√(1 + βa²/ω₀²)/(2K(m)), \
+                     m = βa²/(2(ω₀² + βa²)), K the complete elliptic integral; docs/physics.md §5i–5j",
+            tolerance: 1e-10,
+            compute: duffing_backbone,
+        },
+        Spec {
+            name: "den-hartog-coulomb-amplitude",
+            kind: Kind::Analytic,
+            quantity: "amplitude of the Coulomb-damped oscillator mẍ + kx + F_f sign ẋ = F cos Ωt \
+                       at r = Ω/ω₀ = 1.5, F_f/F = 0.3 (harmonic balance, Richardson 2A(80) − A(40) \
+                       of its first-order convergence)",
+            unit: "m",
+            source: "Den Hartog 1931 (Phil. Mag. 9, 801–817), motion without stops: X = (F/k) \
+                     √(1/(1 − r²)² − (βU)²), U = sin(π/r)/(r(1 + cos(π/r))); docs/physics.md §5i",
+            tolerance: 2e-5,
+            compute: den_hartog,
+        },
     ]
+}
+
+/// One dof `m ẍ + c ẋ + k x + k3 x³ (+ Coulomb friction F_f) = F cos 2πf t`.
+fn one_dof(
+    m: f64,
+    k: f64,
+    c: f64,
+    k3: f64,
+    force: (f64, f64),
+    friction: Option<f64>,
+) -> Result<squeal_core::Lumped, String> {
+    use squeal_core::model::lumped::{ContactSpec, ForceSpec, LumpedSpec, SpringSpec};
+    let x = || vec![("x".to_string(), 1.0)];
+    let spec = LumpedSpec {
+        dofs: vec!["x".into()],
+        masses: vec![("x".into(), m)],
+        springs: vec![SpringSpec {
+            name: "spring".into(),
+            on: x(),
+            k,
+            c,
+            k3,
+        }],
+        forces: vec![ForceSpec {
+            name: "shaker".into(),
+            on: x(),
+            value: 0.0,
+            ramp: 0.0,
+            amplitude: force.0,
+            freq_hz: force.1,
+        }],
+        contacts: friction
+            .map(|ff| ContactSpec {
+                name: "rub".into(),
+                normal: None,
+                k: None,
+                c: None,
+                bilateral: false,
+                normal_force: Some(ff),
+                tangent: Some(x()),
+                v: 0.0,
+                friction: FrictionLaw::Coulomb {
+                    mu_s: 1.0,
+                    mu_k: 1.0,
+                },
+                alpha: 0.0,
+                slope: Vec::new(),
+            })
+            .into_iter()
+            .collect(),
+        ..LumpedSpec::default()
+    };
+    squeal_core::Lumped::build(&spec).map_err(err)
+}
+
+/// Half peak-to-peak of the position of a one-dof series.
+fn series_amplitude(f: &squeal_core::hb::Fourier) -> f64 {
+    let m = 20_000;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for j in 0..m {
+        let z: [f64; 2] = f.state(std::f64::consts::TAU * j as f64 / m as f64);
+        lo = lo.min(z[0]);
+        hi = hi.max(z[0]);
+    }
+    0.5 * (hi - lo)
+}
+
+fn duffing_backbone() -> Result<(f64, f64), String> {
+    use squeal_core::hb::nma::{mode_guess, nonlinear_mode};
+    let (m, k, alpha, k3) = (2.0f64, 2.0e4, 3.0, 4.0e7);
+    let l = one_dof(m, k, alpha * m, k3, (0.0, 0.0), None)?;
+    let sys = squeal_core::model::lumped::Fixed::<2>(&l);
+    let mass = nalgebra::DMatrix::from_element(1, 1, m);
+    let phi = [1.0 / m.sqrt()];
+    let w0 = (k / m).sqrt();
+    let opts = squeal_core::hb::HbOptions {
+        harmonics: 16,
+        ..Default::default()
+    };
+    let (mut g, mut xi) = (mode_guess(&[0.0], &phi, w0, 1e-3), 0.0);
+    let mut last = None;
+    for a in [1e-3, 1e-2, 3e-2, 6e-2] {
+        let s = a / (m.sqrt() * g.amplitude(0, 1));
+        for c in g.coeffs[0].iter_mut().skip(1) {
+            *c *= s;
+        }
+        let p = nonlinear_mode(&sys, &mass, &phi, a, (&g, xi), &opts).map_err(err)?;
+        (g, xi) = (p.orbit.fourier.clone(), p.xi);
+        last = Some(p);
+    }
+    let p = last.ok_or("no point")?;
+    let beta = k3 / m;
+    let x = series_amplitude(&p.orbit.fourier);
+    let s = w0 * w0 + beta * x * x;
+    let mm = beta * x * x / (2.0 * s);
+    let (mut a, mut b) = (1.0f64, (1.0 - mm).sqrt());
+    for _ in 0..60 {
+        (a, b) = (0.5 * (a + b), (a * b).sqrt());
+    }
+    let kk = std::f64::consts::PI / (2.0 * a);
+    let exact = std::f64::consts::PI * s.sqrt() / (2.0 * kk);
+    let tau = std::f64::consts::TAU;
+    Ok((exact / tau, p.freq_hz()))
+}
+
+fn den_hartog() -> Result<(f64, f64), String> {
+    use squeal_core::hb::{forced_response, Fourier, HbOptions};
+    let (m, k, f, ff, r) = (1.0f64, 1.0e4, 10.0, 3.0, 1.5);
+    let w0 = (k / m).sqrt();
+    let hz = r * w0 / std::f64::consts::TAU;
+    let l = one_dof(m, k, 0.0, 0.0, (f, hz), Some(ff))?;
+    let sys = squeal_core::model::lumped::Fixed::<2>(&l);
+    let (beta, x_st, pi) = (ff / f, f / k, std::f64::consts::PI);
+    let u = (pi / r).sin() / (r * (1.0 + (pi / r).cos()));
+    let exact = x_st * (1.0 / (1.0 - r * r).powi(2) - (beta * u).powi(2)).sqrt();
+    let mut g = Fourier {
+        omega: 1.0,
+        coeffs: vec![vec![0.0, exact, 0.0]],
+    };
+    let mut amp = Vec::new();
+    for h in [10, 20, 40, 80] {
+        let o = forced_response(
+            &sys,
+            &g,
+            &HbOptions {
+                harmonics: h,
+                ..Default::default()
+            },
+        )
+        .map_err(err)?;
+        if o.sticks {
+            return Err("the motion stops (stick)".into());
+        }
+        amp.push(series_amplitude(&o.fourier));
+        g = o.fourier;
+    }
+    Ok((exact, 2.0 * amp[3] - amp[2]))
 }
 
 /// Run every case whose name contains `filter` (all when `None`), one
