@@ -508,19 +508,7 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
             "--guess hopf found no stable orbit from steady sliding's growing mode; the guess was settled by simulation instead".into(),
         );
     }
-    let st = Stability {
-        multipliers: c
-            .multipliers
-            .iter()
-            .map(|m| (m.re, m.im, m.trivial))
-            .collect(),
-        stable: c.stable,
-        resolved: !unresolved(&c),
-        max: c.max_multiplier,
-        defect: c.residual,
-        events: c.events_per_period,
-        reference: Some(trivial_abs(&c)),
-    };
+    let st = Stability::of_cycle(&c);
     finish(
         m,
         any,
@@ -548,11 +536,11 @@ struct Hb<const N: usize> {
 }
 
 /// The stability of an HB orbit by one exact period from it.
-struct Stability {
+pub(crate) struct Stability {
     multipliers: Vec<(f64, f64, bool)>,
-    stable: bool,
-    resolved: bool,
-    max: f64,
+    pub(crate) stable: bool,
+    pub(crate) resolved: bool,
+    pub(crate) max: f64,
     defect: f64,
     events: [u64; 5],
     /// The trivial multiplier's modulus (autonomous), whose distance from 1
@@ -561,8 +549,27 @@ struct Stability {
 }
 
 impl Stability {
-    /// Of a forced response: every multiplier of the monodromy counts.
-    fn forced(list: &[cycle::Multiplier], defect: f64, events: [u64; 5]) -> Stability {
+    /// Of an autonomous orbit (`cycle::floquet_from`): the non-trivial
+    /// multipliers, the verdict unresolved within the trivial one's error.
+    pub(crate) fn of_cycle<const N: usize>(c: &cycle::Cycle<N>) -> Stability {
+        Stability {
+            multipliers: c
+                .multipliers
+                .iter()
+                .map(|m| (m.re, m.im, m.trivial))
+                .collect(),
+            stable: c.stable,
+            resolved: !unresolved(c),
+            max: c.max_multiplier,
+            defect: c.residual,
+            events: c.events_per_period,
+            reference: Some(trivial_abs(c)),
+        }
+    }
+
+    /// Of a forced response (`cycle::forced_floquet`): every multiplier of
+    /// the monodromy counts.
+    pub(crate) fn forced(list: &[cycle::Multiplier], defect: f64, events: [u64; 5]) -> Stability {
         let max = list.iter().map(|m| m.re.hypot(m.im)).fold(0.0, f64::max);
         Stability {
             multipliers: list.iter().map(|m| (m.re, m.im, false)).collect(),

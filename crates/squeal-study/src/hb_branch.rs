@@ -10,7 +10,7 @@
 use crate::branch::Guarded;
 use crate::cycle::real_states;
 use crate::error::{Cancel, StudyError};
-use crate::hb::{amplitudes, of_scenario, Guess, HbFound};
+use crate::hb::{amplitudes, of_scenario, Guess, HbFound, Stability};
 use crate::scenario::{InputError, Scenario};
 use rayon::prelude::*;
 use serde_json::{json, Value};
@@ -151,18 +151,15 @@ fn follow_in<M: System<N> + Reparametrise<N> + ?Sized, const N: usize>(
                 let mut out = Err(format!("{name} = {}: no system", pt.p));
                 m.with_param(name, pt.p, &mut |sys| {
                     let z: [f64; N] = pt.orbit.fourier.state(0.0);
-                    out = if forced {
+                    let st = if forced {
                         cycle::forced_floquet(sys, &z, period, opts)
-                            .map(|(l, defect, _)| {
-                                let max = l.iter().map(|x| x.re.hypot(x.im)).fold(0.0, f64::max);
-                                (max, max < 1.0, (max - 1.0).abs() > defect)
-                            })
-                            .map_err(|e| e.to_string())
+                            .map(|(l, defect, events)| Stability::forced(&l, defect, events))
                     } else {
-                        cycle::floquet_from(sys, &z, period, opts)
-                            .map(|c| (c.max_multiplier, c.stable, !crate::hb::unresolved(&c)))
-                            .map_err(|e| e.to_string())
+                        cycle::floquet_from(sys, &z, period, opts).map(|c| Stability::of_cycle(&c))
                     };
+                    out = st
+                        .map(|s| (s.max, s.stable, s.resolved))
+                        .map_err(|e| e.to_string());
                 })
                 .map_err(|e| e.to_string())?;
                 out
