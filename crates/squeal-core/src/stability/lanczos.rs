@@ -26,6 +26,15 @@
 //! `ω/2π ≤` the cut-off — and the [`BLOCK`] next ones beyond have converged,
 //! `‖S x − θ x‖_M ≤` [`RESIDUAL_TOL`]`·θ`.
 //!
+//! A Krylov search can miss a mode: one whose multiplicity exceeds the
+//! block, or to which the start block is (nearly) orthogonal. So the
+//! result is checked as the FE packages check theirs, by a Sturm-sequence
+//! count: the inertia of `K_s − μM` (an `LDLᵀ` factorisation's negative
+//! pivots) is the number of eigenvalues below `μ`, taken in a gap above the
+//! modes kept; if it exceeds the Ritz values found below `μ`, the search is
+//! restarted from a fresh block `M`-orthogonal to the modes found
+//! ([`count_below`], [`STURM_RESTARTS`]).
+//!
 //! No well-kept Rust crate does a sparse generalised symmetric
 //! eigen-solve (faer's eigen-solvers are dense; ARPACK bindings need a
 //! Fortran toolchain), hence the Krylov iteration here; the factorisation,
@@ -313,27 +322,224 @@ pub fn lowest_modes(
     match basis {
         Basis::CutoffHz(f) => {
             let shift = -(std::f64::consts::TAU * f / 5.0).powi(2);
-            lowest_modes_at(ks, m, basis, shift.min(SHIFT))
+            sturm_checked(ks, m, basis, shift.min(SHIFT), None)
         }
         Basis::Modes(_) => {
-            let first = lowest_modes_at(ks, m, basis, SHIFT)?;
-            let top = first.omega2.last().copied().unwrap_or(0.0);
+            let first = lowest_modes_at(ks, m, basis, SHIFT, None)?;
+            let top = first.0.omega2.last().copied().unwrap_or(0.0);
             if top > 1e4 * SHIFT.abs() {
-                lowest_modes_at(ks, m, basis, -top / 25.0)
+                sturm_checked(ks, m, basis, -top / 25.0, None)
             } else {
-                Ok(first)
+                sturm_checked(ks, m, basis, SHIFT, Some(first))
             }
         }
     }
 }
 
-/// [`lowest_modes`] with the shift `sigma` (< 0).
+/// A search's modes, with its converged Ritz values `ω²` ascending (the
+/// modes kept and at least a block beyond; `None`: the basis spans the
+/// whole space).
+type Search = (UndampedBasis, Option<Vec<f64>>);
+
+/// Restarts after a Sturm count finds modes the search missed.
+pub const STURM_RESTARTS: usize = 3;
+
+/// [`lowest_modes_at`] (or its result `first`, at the same `sigma`) checked by a Sturm-sequence count: the number of
+/// eigenvalues of `(K_s, M)` below `μ`, taken between the highest mode kept
+/// and the next Ritz value (for a cut-off, at the cut-off itself unless a
+/// mode lies within 10⁻⁶ of it), must equal the modes kept. A Krylov search
+/// can miss a mode whose multiplicity exceeds the block ([`BLOCK`]) or to
+/// which the start block happens to be orthogonal; the count finds that,
+/// and the search is restarted from a fresh block `M`-orthogonal to the
+/// modes found (they are kept, locked, in the basis), at most
+/// [`STURM_RESTARTS`] times. (Ericsson & Ruhe 1980 §4; Grimes, Lewis &
+/// Simon 1994 §3: the FE packages' Lanczos solvers check the same way.)
+fn sturm_checked(
+    ks: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    basis: Basis,
+    sigma: f64,
+    mut first: Option<Search>,
+) -> Result<UndampedBasis, StabilityError> {
+    let mut locked: Option<UndampedBasis> = None;
+    for _ in 0..=STURM_RESTARTS {
+        let (mut b, ritz_w2) = match first.take() {
+            Some(done) => done,
+            None => lowest_modes_at(ks, m, basis, sigma, locked.as_ref())?,
+        };
+        let Some(ritz_w2) = ritz_w2 else {
+            // Every eigenpair of the pencil was computed: nothing to miss.
+            return Ok(b);
+        };
+        let Some((lo, hi, found)) = sturm_gap(&ritz_w2, b.omega2.len(), basis, sigma) else {
+            // The converged Ritz values beyond the kept modes are one
+            // cluster: no gap to count at (left unchecked, sturm_count None).
+            return Ok(b);
+        };
+        let mu = 0.5 * (lo + hi);
+        let count = count_in_gap(ks, m, lo, hi)?;
+        if count == found {
+            b.sturm_count = Some(b.omega2.len());
+            return Ok(b);
+        }
+        if count < found {
+            return Err(StabilityError::BadInput(format!(
+                "the Lanczos search found {found} undamped modes below {:.6e} Hz but the Sturm count of K_s − μM has only {count}: its Ritz values are not the pencil's (K_s or M not symmetric, or M not positive definite, as read)",
+                mu.max(0.0).sqrt() / std::f64::consts::TAU
+            )));
+        }
+        locked = Some(b);
+    }
+    let b = locked.expect("at least one search ran");
+    Err(StabilityError::BadInput(format!(
+        "the Lanczos search for the undamped modes kept missing modes: after {STURM_RESTARTS} restarts it has {} modes where the Sturm count has more; lower modal.cutoff_hz or modal.modes",
+        b.omega2.len()
+    )))
+}
+
+/// Where to take the Sturm count of a search that kept `kept` modes:
+/// `(lo, hi, the converged Ritz values at or below lo)`, a gap `(lo, hi)`
+/// between two consecutive converged Ritz values, wider than 10⁻⁸ of them.
+/// Normally the gap just above the highest kept mode (for a cut-off, the
+/// first from the cut-off up). Where the kept modes cut a cluster of
+/// repeated eigenvalues (the next Ritz value equals the highest kept one),
+/// the gap just below that cluster: the kept copies of a repeated
+/// eigenvalue are any of its eigenspace, but no mode below it may be
+/// missing. `None` if there is no such gap among the converged values (a
+/// cluster from the lowest mode up; nothing to count).
+fn sturm_gap(ritz_w2: &[f64], kept: usize, basis: Basis, sigma: f64) -> Option<(f64, f64, usize)> {
+    let from = match basis {
+        Basis::CutoffHz(f) => {
+            let c = (std::f64::consts::TAU * f).powi(2);
+            ritz_w2.iter().filter(|&&w2| w2 <= c).count().max(kept)
+        }
+        Basis::Modes(_) => kept,
+    };
+    if from == 0 || from > ritz_w2.len() {
+        return None;
+    }
+    let scale = ritz_w2.last().map_or(0.0, |w| w.abs()).max(sigma.abs());
+    let gap = |j: usize| ritz_w2[j] - ritz_w2[j - 1] > 1e-8 * scale;
+    let at = |j: usize| (ritz_w2[j - 1], ritz_w2[j], j);
+    if from < ritz_w2.len() && !gap(from) {
+        // A cut cluster: below it.
+        return (1..from).rev().find(|&j| gap(j)).map(at);
+    }
+    (from.max(1)..ritz_w2.len()).find(|&j| gap(j)).map(at)
+}
+
+/// [`count_below`] at a point of the gap `(lo, hi)` (no eigenvalue in it,
+/// so every point gives the same count): the middle, else other points
+/// where the unpivoted `LDLᵀ` meets no (near-)zero pivot.
+pub fn count_in_gap(
+    ks: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    lo: f64,
+    hi: f64,
+) -> Result<usize, StabilityError> {
+    let mut last = None;
+    for f in [0.5, 0.3, 0.7, 0.15, 0.85] {
+        match count_below(ks, m, lo + f * (hi - lo)) {
+            Ok(c) => return Ok(c),
+            Err(e) => last = Some(e),
+        }
+    }
+    Err(last.expect("tried"))
+}
+
+/// The number of eigenvalues `ω²` of the symmetric pencil `(K_s, M)` below
+/// `mu` (`M` positive definite): the negative pivots of an `LDLᵀ`
+/// factorisation of `K_s − μM` (Sylvester's law of inertia: `LDLᵀ` is a
+/// congruence, and `K_s − μM` has as many negative eigenvalues as the
+/// pencil has below `μ`). faer's sparse `LDLᵀ` (fill-reducing ordering, no
+/// pivoting: `μ` lies in a gap of the spectrum, so the matrix is regular;
+/// [`count_in_gap`] tries other points of the gap where a pivot vanishes).
+/// Errors if a pivot is not finite or below 10⁻¹⁴ of the largest diagonal
+/// entry of `K_s − μM` in magnitude (the count may then be wrong).
+pub fn count_below(
+    ks: SparseColMatRef<'_, usize, f64>,
+    m: SparseColMatRef<'_, usize, f64>,
+    mu: f64,
+) -> Result<usize, StabilityError> {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+    use faer::sparse::linalg::cholesky::{
+        factorize_symbolic_cholesky, simplicial::SimplicialLdltRef, supernodal::SupernodalLdltRef,
+        CholeskySymbolicParams, SymbolicCholeskyRaw, SymmetricOrdering,
+    };
+    let a = shifted(ks, m, -mu)?;
+    let failed = || {
+        StabilityError::BadInput(format!(
+            "Sturm count: K_s − μM is singular at {:.6e} Hz",
+            mu.max(0.0).sqrt() / std::f64::consts::TAU
+        ))
+    };
+    let sym = factorize_symbolic_cholesky(
+        a.symbolic(),
+        Side::Lower,
+        SymmetricOrdering::Amd,
+        CholeskySymbolicParams::default(),
+    )
+    .map_err(|_| failed())?;
+    let mut values = vec![0.0f64; sym.len_val()];
+    let params = Default::default();
+    let mut mem = MemBuffer::new(sym.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, params));
+    sym.factorize_numeric_ldlt(
+        &mut values,
+        a.as_ref(),
+        Side::Lower,
+        LdltRegularization::default(),
+        Par::Seq,
+        MemStack::new(&mut mem),
+        params,
+    )
+    .map_err(|_| failed())?;
+    let pivots: Vec<f64> = match sym.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => {
+            // Each column of the factor starts with its diagonal: D.
+            let l = SimplicialLdltRef::new(s, &values);
+            let col_ptr = l.symbolic().col_ptr();
+            (0..s.nrows()).map(|j| values[col_ptr[j]]).collect()
+        }
+        SymbolicCholeskyRaw::Supernodal(s) => {
+            let l = SupernodalLdltRef::new(s, &values);
+            (0..s.n_supernodes())
+                .flat_map(|k| {
+                    let node = l.supernode(k).val();
+                    (0..node.ncols()).map(move |j| node[(j, j)])
+                })
+                .collect()
+        }
+    };
+    let diag = (0..a.ncols())
+        .flat_map(|j| {
+            a.row_idx_of_col(j)
+                .zip(a.val_of_col(j))
+                .filter(move |(i, _)| *i == j)
+                .map(|(_, v)| v.abs())
+        })
+        .fold(0.0f64, f64::max);
+    if pivots
+        .iter()
+        .any(|d| !d.is_finite() || d.abs() <= 1e-14 * diag)
+    {
+        return Err(failed());
+    }
+    Ok(pivots.iter().filter(|&&d| d < 0.0).count())
+}
+
+/// [`lowest_modes`] with the shift `sigma` (< 0), unchecked; with the
+/// converged Ritz values `ω²`, ascending (the modes kept and at least a
+/// block beyond; `None`: the basis spans the whole space). `locked`: modes already found (at the same shift), kept
+/// in the basis as its first vectors, the search starting `M`-orthogonal
+/// to them ([`sturm_checked`]'s restart).
 fn lowest_modes_at(
     ks: SparseColMatRef<'_, usize, f64>,
     m: SparseColMatRef<'_, usize, f64>,
     basis: Basis,
     sigma: f64,
-) -> Result<UndampedBasis, StabilityError> {
+    locked: Option<&UndampedBasis>,
+) -> Result<Search, StabilityError> {
     let n = ks.nrows();
     if n == 0 || m.nrows() != n || ks.ncols() != n || m.ncols() != n {
         return Err(StabilityError::BadInput(
@@ -373,7 +579,31 @@ fn lowest_modes_at(
     };
     let mut h = Mat::<f64>::zeros(room, room);
     let mut fresh = 0u64;
-    let mut w = pseudo_random(n, p, 0);
+    let mut seed = 0u64;
+    if let Some(l) = locked {
+        // The locked modes are eigenvectors of S: H is diagonal there, θ = 1/(ω² − σ).
+        let k = l.phi.ncols();
+        if k + 2 * p > cap {
+            return Err(StabilityError::BadInput(format!(
+                "the Lanczos restart has no room beyond the {k} modes found ({n} dofs); lower modal.cutoff_hz or modal.modes"
+            )));
+        }
+        room = room.max(k + 8 * p).min(cap);
+        kr.q.resize_with(n, room, |_, _| 0.0);
+        kr.mq.resize_with(n, room, |_, _| 0.0);
+        h.resize_with(room, room, |_, _| 0.0);
+        let mphi = sparse_mul(m, l.phi.as_ref());
+        for j in 0..k {
+            for i in 0..n {
+                kr.q[(i, j)] = l.phi[(i, j)];
+                kr.mq[(i, j)] = mphi[(i, j)];
+            }
+            h[(j, j)] = 1.0 / (l.omega2[j] - sigma);
+        }
+        kr.s = k;
+        seed = 1 + k as u64;
+    }
+    let mut w = pseudo_random(n, p, seed);
     let (_, _) = kr.orthonormalise(m, &mut w, &mut fresh);
     kr.push(m, &w);
     let mut last_check = 0usize;
@@ -440,7 +670,7 @@ fn ritz(
     sigma: f64,
     wanted_w2: Option<f64>,
     want_count: usize,
-) -> Result<Option<UndampedBasis>, StabilityError> {
+) -> Result<Option<Search>, StabilityError> {
     let s = kr.s;
     let hs = Mat::<f64>::from_fn(s, s, |i, j| 0.5 * (h[(i, j)] + h[(j, i)]));
     let (theta, y) = symmetric_eigen(hs.as_ref())?;
@@ -502,9 +732,27 @@ fn ritz(
         1.0,
         Par::Seq,
     );
-    Ok(Some(UndampedBasis {
-        phi,
-        omega2: keep.iter().map(|&i| w2(i)).collect(),
-        static_vectors: 0,
-    }))
+    // The converged Ritz values (ascending: the kept ones and at least a
+    // block beyond), where the Sturm count is compared; none when the
+    // basis spans the whole space.
+    let ritz_w2 = if complete {
+        None
+    } else {
+        Some(
+            order
+                .iter()
+                .take_while(|&&i| converged(i))
+                .map(|&i| w2(i))
+                .collect(),
+        )
+    };
+    Ok(Some((
+        UndampedBasis {
+            phi,
+            omega2: keep.iter().map(|&i| w2(i)).collect(),
+            static_vectors: 0,
+            sturm_count: None,
+        },
+        ritz_w2,
+    )))
 }

@@ -264,6 +264,11 @@ pub enum Method {
         /// What spans the basis (`modal.basis`); `modes` then counts the
         /// fixed-interface modes of a Craig–Bampton basis.
         basis: BasisKind,
+        /// The sparse Lanczos path's Sturm-sequence count of the undamped
+        /// modes below the basis's top (equal to `modes`: none was missed);
+        /// absent where every mode was computed by a dense solve.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        sturm_count: Option<usize>,
     },
 }
 
@@ -280,6 +285,11 @@ pub struct UndampedBasis {
     pub omega2: Vec<f64>,
     /// How many of the last columns are static-correction vectors.
     pub static_vectors: usize,
+    /// For a sparse Lanczos basis: the modes kept, when a Sturm-sequence
+    /// count (the inertia of `K_s − μM`, [`super::lanczos::count_below`])
+    /// confirmed that none below the highest kept was missed; `None` where
+    /// every mode was computed (dense solves) or no gap allowed the count.
+    pub sturm_count: Option<usize>,
 }
 
 /// The dofs where the linearised coupling is non-symmetric, `K ≠ Kᵀ` or
@@ -407,6 +417,7 @@ fn augment<S: Structure + ?Sized>(
         phi,
         omega2,
         static_vectors: r,
+        sturm_count: b.sturm_count,
     })
 }
 
@@ -522,6 +533,7 @@ pub fn undamped_basis(sys: &SecondOrder, basis: Basis) -> Result<UndampedBasis, 
         phi,
         omega2: omega2[..m].to_vec(),
         static_vectors: 0,
+        sturm_count: None,
     })
 }
 
@@ -570,6 +582,7 @@ fn method<S: Structure + ?Sized>(sys: &S, b: &UndampedBasis, basis: BasisKind) -
             / (2.0 * std::f64::consts::PI),
         static_vectors: b.static_vectors,
         basis,
+        sturm_count: b.sturm_count,
     }
 }
 
@@ -645,6 +658,7 @@ fn ritz_basis(
         phi,
         omega2,
         static_vectors: nb,
+        sturm_count: None,
     })
 }
 
@@ -698,6 +712,7 @@ pub fn truncation_table<S: Structure + ?Sized>(
                 phi: full.phi.subcols(0, k).to_owned(),
                 omega2: full.omega2[..k].to_vec(),
                 static_vectors: 0,
+                sturm_count: None,
             };
             let b = augment(sys, b, &responses)?;
             let a = reduced_state_matrix(sys, &b);

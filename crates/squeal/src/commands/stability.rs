@@ -39,8 +39,10 @@ fn modal_line(an: &Analysis) -> Option<String> {
             basis_max_hz,
             static_vectors,
             basis: squeal_core::stability::projected::BasisKind::Modes,
+            sturm_count,
         } => Some(format!(
-            "projected onto the {modes} lowest undamped modes of {dofs} dofs (up to {basis_max_hz:.1} Hz) and {static_vectors} static-correction vectors at the contact dofs: a reduced-basis answer for the modes in that band, none above it (modal.modes / modal.cutoff_hz / modal.dense_max_dofs choose)"
+            "projected onto the {modes} lowest undamped modes of {dofs} dofs (up to {basis_max_hz:.1} Hz{}) and {static_vectors} static-correction vectors at the contact dofs: a reduced-basis answer for the modes in that band, none above it (modal.modes / modal.cutoff_hz / modal.dense_max_dofs choose)",
+            sturm_words(sturm_count)
         )),
         squeal_core::stability::projected::Method::Projected {
             modes,
@@ -48,9 +50,20 @@ fn modal_line(an: &Analysis) -> Option<String> {
             basis_max_hz,
             static_vectors,
             basis: squeal_core::stability::projected::BasisKind::CraigBampton,
+            sturm_count,
         } => Some(format!(
-            "projected onto a Craig–Bampton basis of {dofs} dofs: the {static_vectors} contact dofs kept physical and {modes} fixed-interface modes (up to {basis_max_hz:.1} Hz): a reduced-basis answer for the modes in that band, none above it (modal.basis / modal.modes / modal.cutoff_hz / modal.dense_max_dofs choose)"
+            "projected onto a Craig–Bampton basis of {dofs} dofs: the {static_vectors} contact dofs kept physical and {modes} fixed-interface modes (up to {basis_max_hz:.1} Hz{}): a reduced-basis answer for the modes in that band, none above it (modal.basis / modal.modes / modal.cutoff_hz / modal.dense_max_dofs choose)",
+            sturm_words(sturm_count)
         )),
+    }
+}
+
+/// ", none missed (Sturm count)" when the Lanczos path's count confirmed the modes.
+fn sturm_words(count: Option<usize>) -> &'static str {
+    if count.is_some() {
+        ", none missed: Sturm count"
+    } else {
+        ""
     }
 }
 
