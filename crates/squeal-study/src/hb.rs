@@ -270,18 +270,21 @@ impl Guess {
 /// the linear motion first takes a contact's sliding velocity or normal
 /// force to zero (each is affine in the state near steady sliding, so its
 /// linear variation is exact by differences), times `factor`. `None` if
-/// steady sliding has no growing oscillatory mode.
-fn hopf_guess<M: System<N> + ?Sized, const N: usize>(
+/// steady sliding has no growing oscillatory mode (`growing_only`), or no
+/// oscillatory mode at all (else: the least stable one, as at a Hopf point,
+/// where it is neutral).
+pub(crate) fn hopf_guess<M: System<N> + ?Sized, const N: usize>(
     m: &M,
     real: &[usize],
     factor: f64,
+    growing_only: bool,
 ) -> Result<Option<Fourier>, StudyError> {
     let a = squeal_core::stability::analyse(m)
         .map_err(|e| StudyError::Numerical(format!("hb --guess hopf: {e}")))?;
     let Some(e) = a
         .eigen
         .iter()
-        .filter(|e| e.growing && e.im > 0.0)
+        .filter(|e| (e.growing || !growing_only) && e.im > 0.0)
         .max_by(|x, y| x.re.total_cmp(&y.re))
     else {
         return Ok(None);
@@ -347,7 +350,7 @@ fn from_hopf<M: System<N> + ?Sized, const N: usize>(
     cancel: &Cancel,
 ) -> Result<Option<Solved<N>>, StudyError> {
     for factor in [1.0, 2.0, 0.5] {
-        let Some(g) = hopf_guess(m, real, factor)? else {
+        let Some(g) = hopf_guess(m, real, factor, true)? else {
             return Ok(None);
         };
         let Ok((o, conv, amp, notes)) = ladder(m, &g.resized(harmonics), harmonics, real, cancel)

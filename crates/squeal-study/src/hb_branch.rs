@@ -16,8 +16,9 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 use squeal_core::cycle::continuation::{Reparametrise, Varied};
 use squeal_core::cycle::{self, CycleOptions};
-use squeal_core::hb::continuation::{hb_branch, HbBranchEnd, HbBranchOptions};
+use squeal_core::hb::continuation::{hb_branch_from, BranchStart, HbBranchEnd, HbBranchOptions};
 use squeal_core::hb::{HbError, HbOptions};
+use squeal_core::stability::Crossing;
 use squeal_core::System;
 
 /// One point of an HB branch.
@@ -59,15 +60,22 @@ pub struct HbBranchFound {
     pub folds: Vec<f64>,
     /// Why the branch ended.
     pub end: String,
-    /// `squeal hb` at the first value.
-    pub start: HbFound,
+    /// `squeal hb` at the first value (`None`: no orbit there; the branch
+    /// then starts at the Hopf point `hopf`).
+    pub start: Option<HbFound>,
+    /// Where the branch was born from steady sliding, when it was started
+    /// there (`critical`'s Hopf point in the range).
+    pub hopf: Option<Crossing>,
     /// What the numbers do not support.
     pub warnings: Vec<String>,
 }
 
-fn why_end(e: &HbBranchEnd, hi: f64) -> String {
+fn why_end(e: &HbBranchEnd, lo: f64, hi: f64, from_hopf: bool) -> String {
     match e {
         HbBranchEnd::Reached => format!("reached the range's end ({hi})"),
+        HbBranchEnd::LeftRange if from_hopf => {
+            format!("left the range at its start ({lo}): the orbit grows towards it")
+        }
         HbBranchEnd::LeftRange => "turned back and left the range at its start".into(),
         HbBranchEnd::Collapsed(p) => {
             format!("the orbit shrank onto steady sliding near {p} (a Hopf point)")
@@ -83,6 +91,13 @@ fn why_end(e: &HbBranchEnd, hi: f64) -> String {
 /// spacing `(hi − lo)/(steps − 1)` the largest step (`--param`, checked by
 /// `crate::branch::parse_range`), with `harmonics` harmonics; `opts` are
 /// `squeal cycle`'s (the first point's settling, the Floquet periods).
+///
+/// A self-excited model with no orbit at `lo` that HB takes (its
+/// oscillation dies out there, or its orbit there sticks) whose steady
+/// sliding changes stability inside the range
+/// (`critical`'s Hopf point, scanned on 64 points) has its branch started
+/// at that Hopf point instead, from the critical mode's small orbit
+/// ([`BranchStart::Hopf`]), and followed in the direction the orbit grows.
 pub fn follow(
     sc: &Scenario,
     name: &str,
@@ -100,7 +115,18 @@ pub fn follow(
         .model
         .set(name, lo)
         .map_err(|e| InputError(format!("--param {name}={lo}: {e}")))?;
-    let start = of_scenario(&first, harmonics, opts, Guess::Settle, false, cancel)?;
+    let (start, hopf) = match of_scenario(&first, harmonics, opts, Guess::Settle, false, cancel) {
+        Ok(s) => (Some(s), None),
+        Err(e @ StudyError::Interrupted) => return Err(e),
+        Err(e) if !sc.model.forcing_hz().is_empty() => return Err(e),
+        Err(e) => match crate::critical::locate(&sc.model, name, lo, hi, 64, cancel) {
+            Ok(Some(c)) if !c.from_neutral && c.value > lo.min(hi) && c.value < lo.max(hi) => {
+                (None, Some(c))
+            }
+            _ => return Err(e),
+        },
+    };
+    cancel.check()?;
     let bopts = HbBranchOptions {
         hb: HbOptions {
             harmonics,
@@ -110,7 +136,7 @@ pub fn follow(
     };
     let names = sc.model.state_names();
     crate::with_sim_system!(&sc.model, m => {
-        follow_in(m, name, lo, hi, steps, harmonics, opts, start, names, &bopts, cancel)
+        follow_in(m, name, lo, hi, steps, harmonics, opts, (start, hopf), names, &bopts, cancel)
     }, else => Err(StudyError::Input(InputError(sc.model.check_cycle_size().err().unwrap_or_default()))))
 }
 
@@ -123,7 +149,7 @@ fn follow_in<M: System<N> + Reparametrise<N> + ?Sized, const N: usize>(
     steps: usize,
     harmonics: usize,
     opts: &CycleOptions,
-    start: HbFound,
+    (start, hopf): (Option<HbFound>, Option<Crossing>),
     names: Vec<String>,
     bopts: &HbBranchOptions,
     cancel: &Cancel,
@@ -134,13 +160,51 @@ fn follow_in<M: System<N> + Reparametrise<N> + ?Sized, const N: usize>(
             inner: &family,
             cancel,
         };
-        let br = hb_branch(&guarded, lo, hi, steps, &start.series, bopts).map_err(|e| match e {
-            HbError::Bad(m) => StudyError::Input(InputError(format!("hb --param: {m}"))),
-            other => StudyError::Numerical(format!("hb --param: {other}")),
-        })?;
-        cancel.check()?;
         let real = real_states::<N>(m.norm_states());
-        let forced = start.forcing_hz.is_some();
+        let (series, from) = match (&start, &hopf) {
+            (Some(s), _) => (s.series.clone(), BranchStart::Lo),
+            (None, Some(c)) => {
+                // The critical mode's orbit at 5 % of the amplitude where its
+                // motion first meets a nonlinearity, measured in that amplitude.
+                let mut guess = Err(StudyError::Numerical(format!(
+                    "hb --param: {name} = {}: no system",
+                    c.value
+                )));
+                m.with_param(name, c.value, &mut |sys| {
+                    guess = crate::hb::hopf_guess(sys, &real, 1.0, false);
+                })
+                .map_err(|e| StudyError::Numerical(format!("hb --param: {e}")))?;
+                let Some(full) = guess? else {
+                    return Err(StudyError::Numerical(format!(
+                        "hb --param: no orbit at {name} = {lo}, and at the Hopf point {name} = {} the critical mode meets no nonlinearity to bound its orbit",
+                        c.value
+                    )));
+                };
+                let top = (0..full.coeffs.len())
+                    .map(|i| full.amplitude(i, 1))
+                    .fold(0.0, f64::max);
+                let mut small = full.clone();
+                for cf in &mut small.coeffs {
+                    cf[1] *= 0.05;
+                    cf[2] *= 0.05;
+                }
+                (
+                    small,
+                    BranchStart::Hopf {
+                        p_h: c.value,
+                        scale: top,
+                    },
+                )
+            }
+            (None, None) => unreachable!("follow gives a start or a Hopf point"),
+        };
+        let br =
+            hb_branch_from(&guarded, lo, hi, steps, &series, from, bopts).map_err(|e| match e {
+                HbError::Bad(m) => StudyError::Input(InputError(format!("hb --param: {m}"))),
+                other => StudyError::Numerical(format!("hb --param: {other}")),
+            })?;
+        cancel.check()?;
+        let forced = start.as_ref().is_some_and(|s| s.forcing_hz.is_some());
         // Each point's stability by one exact period (independent, in
         // parallel; the order of the results is the points').
         let stab: Vec<Result<(f64, bool, bool), String>> = br
@@ -178,7 +242,7 @@ fn follow_in<M: System<N> + Reparametrise<N> + ?Sized, const N: usize>(
                 }
             })
             .collect();
-        let mut warnings = start.warnings.clone();
+        let mut warnings = start.as_ref().map_or_else(Vec::new, |s| s.warnings.clone());
         let mut rows = Vec::with_capacity(br.points.len());
         for (k, (pt, st)) in br.points.iter().zip(stab).enumerate() {
             let (max, stable, resolved) = match st {
@@ -214,8 +278,9 @@ fn follow_in<M: System<N> + Reparametrise<N> + ?Sized, const N: usize>(
             names,
             rows,
             folds: br.folds.iter().map(|&(_, p)| p).collect(),
-            end: why_end(&br.end, hi),
+            end: why_end(&br.end, lo, hi, hopf.is_some()),
             start,
+            hopf,
             warnings,
         })
     }
@@ -226,7 +291,9 @@ impl HbBranchFound {
     /// (per point `value`, `period`, `freq_hz`, `amplitude` per state,
     /// `max_multiplier`, `stable`, `stability_resolved`, `residual`,
     /// `point`), `folds`, `end`, `start` (`squeal hb`'s document at the
-    /// first value) and `warnings`.
+    /// first value; null when there is no orbit there), `hopf` (`value`,
+    /// `freq_hz` of the Hopf point the branch started at, or null) and
+    /// `warnings`.
     pub fn to_json(&self) -> Value {
         let points: Vec<Value> = self
             .rows
@@ -253,7 +320,8 @@ impl HbBranchFound {
             "points": points,
             "folds": self.folds,
             "end": self.end,
-            "start": self.start.to_json(),
+            "start": self.start.as_ref().map_or(Value::Null, HbFound::to_json),
+            "hopf": self.hopf.as_ref().map_or(Value::Null, |c| json!({"value": c.value, "freq_hz": c.freq_hz})),
             "warnings": self.warnings,
         })
     }

@@ -371,3 +371,98 @@ fn the_friction_dampers_nonlinear_mode() {
         assert!(err.contains(want), "{err}");
     }
 }
+
+/// `hb --param` from a Hopf point: with no orbit at LO (steady sliding is
+/// stable there), the branch starts at `critical`'s Hopf point inside the
+/// range. On the belt with the (exponential) Stribeck law the Hopf point is
+/// generic, so near it the amplitude grows as `A² ∝ p − p_h` (the normal
+/// form), the orbit has the critical mode's frequency, and it ends where
+/// its velocity amplitude reaches the belt speed (stick, which HB does not
+/// balance).
+#[test]
+fn hb_param_starts_at_the_hopf_point_when_lo_has_no_orbit() {
+    let d = tempfile::tempdir().unwrap();
+    let set = ["--set", "friction=stribeck"];
+    let crit = json_of(&squeal(
+        d.path(),
+        &[
+            &["critical", "belt", "--param", "V=0.01:0.1", "--json"][..],
+            &set,
+        ]
+        .concat(),
+    ));
+    let br = json_of(&squeal(
+        d.path(),
+        &[
+            &["hb", "belt", "--param", "V=0.01:0.1:10", "--json"][..],
+            &set,
+        ]
+        .concat(),
+    ));
+    assert!(br["start"].is_null());
+    let vh = crit["value"].as_f64().unwrap();
+    assert!((br["hopf"]["value"].as_f64().unwrap() - vh).abs() <= 1e-12 * vh);
+    let fh = crit["freq_hz"].as_f64().unwrap();
+    let pts = br["points"].as_array().unwrap();
+    assert!(pts.len() >= 3, "{br}");
+    let at = |k: usize| {
+        (
+            pts[k]["value"].as_f64().unwrap(),
+            pts[k]["amplitude"]["x"].as_f64().unwrap(),
+            pts[k]["freq_hz"].as_f64().unwrap(),
+        )
+    };
+    let ((v1, a1, f1), (v2, a2, _)) = (at(0), at(1));
+    // Supercritical: the orbit is on the unstable side (V > V_h), stable.
+    assert!(v1 > vh && v2 > v1, "{v1} {v2} {vh}");
+    assert!(pts.iter().all(|p| p["stable"] == true));
+    assert!((f1 - fh).abs() <= 1e-6 * fh, "{f1} vs {fh}");
+    // (V₂ − V_h)/(V₁ − V_h) = (A₂/A₁)² near the Hopf point (3 %).
+    let law = ((v2 - vh) / (v1 - vh)) / (a2 / a1).powi(2);
+    assert!((law - 1.0).abs() < 0.03, "A² law off by {law}");
+    // The last orbit's velocity amplitude ωA has reached the belt speed.
+    let (vl, al, fl) = at(pts.len() - 1);
+    let speed = std::f64::consts::TAU * fl * al;
+    assert!((speed - vl).abs() <= 2e-3 * vl, "{speed} vs {vl}");
+}
+
+/// Hoffmann's model: no orbit at μ = 0.1, the branch from its Hopf point
+/// (vertical while the model is linear, then bent by contact loss); on it,
+/// HB equals shooting at the same μ.
+#[test]
+fn hb_param_from_the_hopf_point_equals_shooting_on_the_branch() {
+    let d = tempfile::tempdir().unwrap();
+    let br = json_of(&squeal(
+        d.path(),
+        &["hb", "hoffmann", "--param", "mu=0.1:0.5:9", "--json"],
+    ));
+    assert!(br["start"].is_null());
+    let mu_c = br["hopf"]["value"].as_f64().unwrap();
+    assert!((mu_c - 0.2501375).abs() < 1e-6, "{mu_c}");
+    assert_eq!(br["folds"].as_array().unwrap().len(), 0, "{br}");
+    let p = br["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .min_by(|a, b| {
+            let d = |p: &serde_json::Value| (p["value"].as_f64().unwrap() - 0.3).abs();
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap();
+    let mu = p["value"].as_f64().unwrap();
+    assert!((mu - 0.3).abs() < 0.01, "{mu}");
+    let cy = json_of(&squeal(
+        d.path(),
+        &["cycle", "hoffmann", "--set", &format!("mu={mu}"), "--json"],
+    ));
+    let (fh, fc) = (
+        p["freq_hz"].as_f64().unwrap(),
+        cy["frequency_hz"].as_f64().unwrap(),
+    );
+    assert!((fh - fc).abs() <= 1e-8 * fc, "{fh} vs {fc}");
+    let (ah, ac) = (
+        p["amplitude"]["y"].as_f64().unwrap(),
+        cy["amplitude"]["y"].as_f64().unwrap(),
+    );
+    assert!((ah - ac).abs() <= 1e-4 * ac, "{ah} vs {ac}");
+}

@@ -19,6 +19,12 @@
 //! tangent's `p` component changes sign; it is located on the parabola
 //! `p(s)` through the three points around it (chord arclength). The last
 //! point is solved at the range's end exactly.
+//!
+//! A self-excited branch may also start at a Hopf point inside the range
+//! ([`BranchStart::Hopf`]), where it is born from steady sliding with zero
+//! amplitude: entered at two small first-harmonic amplitudes with the
+//! parameter free (Kuznetsov, *Elements of Applied Bifurcation Theory*,
+//! §3.4: `p − p_h ∝ A²` on either side), then followed as above.
 
 use super::{
     fd_jacobian, forced_scales, forcing_omega, harmonic_amplitudes, newton, Balance, Fourier,
@@ -26,6 +32,9 @@ use super::{
 };
 use crate::cycle::continuation::Family;
 use nalgebra::{DMatrix, DVector};
+
+/// A unit tangent's `p` component below this is round-off (no fold sign).
+const DP_ROUNDOFF: f64 = 1e-6;
 
 /// Settings of [`hb_branch`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,6 +86,29 @@ pub enum HbBranchEnd {
     MaxPoints,
 }
 
+/// Where a branch starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BranchStart {
+    /// The solution given, solved at `p = lo`.
+    Lo,
+    /// A Hopf point `p_h` of an autonomous model inside the range: the
+    /// solution given is the small orbit `q* + A·Re(φ e^{iωt})` of the
+    /// critical mode there (its largest first-harmonic amplitude `A`), and
+    /// `scale` (m, > `A`) the amplitude in which the branch's coefficients
+    /// are measured (where that motion first meets a nonlinearity, say).
+    /// The branch is entered at the first-harmonic amplitudes `A` and `2A`
+    /// with `p` free (`R(x; p) = 0` and `a₁ = A` of the phase dof; near a
+    /// Hopf point `p − p_h ∝ A²`, so this finds super- and subcritical
+    /// branches alike), and followed from `2A` in the direction of growing
+    /// amplitude.
+    Hopf {
+        /// The Hopf point.
+        p_h: f64,
+        /// The amplitude scale (m).
+        scale: f64,
+    },
+}
+
 /// A branch of HB solutions.
 #[derive(Debug, Clone)]
 pub struct HbBranch {
@@ -101,6 +133,20 @@ pub fn hb_branch<const N: usize>(
     start: &Fourier,
     opts: &HbBranchOptions,
 ) -> Result<HbBranch, HbError> {
+    hb_branch_from(family, lo, hi, steps, start, BranchStart::Lo, opts)
+}
+
+/// [`hb_branch`] from where `from` says: `lo`, or a Hopf point inside the
+/// range ([`BranchStart::Hopf`]).
+pub fn hb_branch_from<const N: usize>(
+    family: &(dyn Family<N> + Sync),
+    lo: f64,
+    hi: f64,
+    steps: usize,
+    start: &Fourier,
+    from: BranchStart,
+    opts: &HbBranchOptions,
+) -> Result<HbBranch, HbError> {
     if !(lo.is_finite() && hi.is_finite() && lo != hi && steps >= 2) {
         return Err(HbError::Bad(format!(
             "the range {lo}:{hi}:{steps}: needs two different ends and at least 2 steps"
@@ -116,6 +162,11 @@ pub fn hb_branch<const N: usize>(
         .visit(lo, &mut |sys| forced = Some(forcing_omega(sys)))
         .map_err(HbError::Bad)?;
     let forced = forced.expect("visited")?;
+    if forced.is_some() && from != BranchStart::Lo {
+        return Err(HbError::Bad(
+            "a forced model's branch has no Hopf point to start from".into(),
+        ));
+    }
     let lay = if forced.is_some() {
         Layout {
             n,
@@ -135,11 +186,17 @@ pub fn hb_branch<const N: usize>(
         // The time origin where the phase condition holds (free for an
         // autonomous orbit).
         f0 = f0.shifted(f0.coeffs[phase_dof][2].atan2(f0.coeffs[phase_dof][1]));
+        // From a Hopf point the orbit is measured in the given scale, not
+        // in its own (small) size.
+        let grow = match from {
+            BranchStart::Hopf { scale, .. } if top > 0.0 => (scale / top).max(1.0),
+            _ => 1.0,
+        };
         Layout {
             n,
             h,
             panels: opts.hb.panel_count(),
-            scale: amp.iter().map(|a| a.max(1e-6 * top)).collect(),
+            scale: amp.iter().map(|a| grow * a.max(1e-6 * top)).collect(),
             omega0: f0.omega,
             phase_dof: Some(phase_dof),
             mode: None,
@@ -220,9 +277,63 @@ pub fn hb_branch<const N: usize>(
     };
     let admissible = |xx: &[f64]| !autonomous || xx[m - 1] > 0.0;
     let mut x: Vec<f64> = lay.to_x(&f0);
-    x.push(0.0);
     let mut t_prev = DVector::<f64>::zeros(m + 1);
-    t_prev[m] = 1.0;
+    match from {
+        BranchStart::Lo => {
+            x.push(0.0);
+            t_prev[m] = 1.0;
+        }
+        BranchStart::Hopf { p_h, .. } => {
+            let k = lay.phase_dof.expect("autonomous");
+            // The first-harmonic cosine of the phase dof (scaled): fixed.
+            let ia = k * lay.width() + 1;
+            let at = |xx: &[f64], a: f64| {
+                let fixed = |xs: &[f64], o: &mut [f64]| {
+                    residual(xs, &mut o[..m]);
+                    o[m] = xs[ia] - a;
+                };
+                let fixed_jac = |xs: &[f64], r: &[f64]| {
+                    let mut j = DMatrix::<f64>::zeros(m + 1, m + 1);
+                    j.view_mut((0, 0), (m, m + 1)).copy_from(&jacobian(xs, r));
+                    j[(m, ia)] = 1.0;
+                    j
+                };
+                newton(
+                    &fixed,
+                    &fixed_jac,
+                    &admissible,
+                    xx.to_vec(),
+                    opts.hb.newton_tol,
+                    opts.hb.newton_iterations,
+                    "the branch's start at the Hopf point",
+                )
+            };
+            let p_hs = (p_h - lo) / dp;
+            x.push(p_hs);
+            let a1 = x[ia];
+            let s1 = at(&x, a1)?;
+            // Twice the amplitude: every harmonic doubled, p − p_h four times.
+            let mut x2 = s1.x.clone();
+            for i in 0..n {
+                for c in 1..lay.width() {
+                    x2[i * lay.width() + c] *= 2.0;
+                }
+            }
+            x2[m] = p_hs + 4.0 * (s1.x[m] - p_hs);
+            let s2 = at(&x2, 2.0 * a1)?;
+            for i in 0..=m {
+                t_prev[i] = s2.x[i] - s1.x[i];
+            }
+            let norm = t_prev.norm();
+            if !(norm.is_finite() && norm > 0.0) {
+                return Err(HbError::NotConverged(
+                    "no direction out of the Hopf point".into(),
+                ));
+            }
+            t_prev /= norm;
+            x = s2.x;
+        }
+    }
     let mut t = tangent(&x, &t_prev)
         .ok_or_else(|| HbError::NotConverged("no tangent at the branch's start".into()))?;
     let mut r0 = vec![0.0; m];
@@ -230,11 +341,12 @@ pub fn hb_branch<const N: usize>(
     let res0 = super::max_abs(&r0);
     if res0.is_nan() || res0 > super::STALLED * opts.hb.newton_tol {
         return Err(HbError::NotConverged(format!(
-            "the start is not a solution at {lo} (residual {res0:.3e})"
+            "the start is not a solution at {} (residual {res0:.3e})",
+            param(x[m])
         )));
     }
     let first = point(&x, res0, 0, res0 <= opts.hb.newton_tol, t[m])
-        .ok_or_else(|| HbError::Bad(format!("the model at {lo}")))?;
+        .ok_or_else(|| HbError::Bad(format!("the model at {}", param(x[m]))))?;
     let amp_of = |o: &HbOrbit| {
         harmonic_amplitudes(&o.fourier)
             .into_iter()
@@ -247,6 +359,7 @@ pub fn hb_branch<const N: usize>(
         end: HbBranchEnd::MaxPoints,
     };
     let mut s_hist = vec![0.0f64];
+    let mut sig_dp = if t[m].abs() > DP_ROUNDOFF { t[m] } else { 0.0 };
     let mut ds = opts.max_step;
     let tol = opts.hb.newton_tol;
     while out.points.len() < opts.max_points {
@@ -338,10 +451,16 @@ pub fn hb_branch<const N: usize>(
         s_hist.push(s_hist.last().copied().unwrap_or(0.0) + chord);
         let amp = amp_of(&pt.orbit);
         a_max = a_max.max(amp);
-        let prev_dp = out.points.last().map_or(tn[m], |q| q.dp_ds);
         out.points.push(pt);
         let k = out.points.len() - 1;
-        if prev_dp * tn[m] < 0.0 && k >= 2 {
+        // A fold where dp/ds changes sign; components at round-off (a
+        // branch leaving a Hopf point vertically, where the model is linear
+        // below its first nonlinearity) carry no sign.
+        let turned = tn[m].abs() > DP_ROUNDOFF && sig_dp * tn[m] < 0.0;
+        if tn[m].abs() > DP_ROUNDOFF {
+            sig_dp = tn[m];
+        }
+        if turned && k >= 2 {
             // The fold: the extreme of the parabola p(s) through the last three points.
             let (s0, s1, s2) = (s_hist[k - 2], s_hist[k - 1], s_hist[k]);
             let (p0, p1, p2) = (out.points[k - 2].p, out.points[k - 1].p, out.points[k].p);
