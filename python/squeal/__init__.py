@@ -901,10 +901,16 @@ def hb(
     has ``points`` (per point ``value``, ``freq_hz``, ``period``,
     ``amplitude`` per state, ``max_multiplier``, ``stable``, ``point``:
     ``step`` or ``fold``), ``folds`` (the parameter at each), ``end``,
-    ``start`` (the document at ``LO``) and ``warnings``; ``out`` gets
-    ``branch.csv``, ``summary.json`` and ``hb_branch.png``."""
+    ``start`` (the document at ``LO``) and ``warnings``, and ``table``
+    (float64, one row per point, as ``branch.csv`` without ``stable`` and
+    ``point``) with its ``table_columns``; ``out`` gets ``branch.csv``,
+    ``summary.json`` and ``hb_branch.png``.
+
+    Without ``param``, besides the document: ``orbit`` (float64, one
+    period of the series sampled, rows × ``orbit_columns``: ``t`` and the
+    states), as ``cycle`` returns its orbit."""
     if param is not None:
-        return dict(
+        branch_doc: Dict[str, Any] = dict(
             json.loads(
                 _squeal.hb_branch(
                     *_source(scenario),
@@ -918,20 +924,38 @@ def hb(
                 )
             )
         )
-    return dict(
-        json.loads(
-            _squeal.hb(
-                *_source(scenario),
-                _sets(set, params),
-                int(harmonics),
-                int(settle_steps),
-                float(settle_time),
-                float(settle_tol),
-                str(guess),
-                _out(out),
-            )
-        )
+        points = branch_doc["points"]
+        names = list(points[0]["amplitude"]) if points else []
+        columns = [str(param[0]), "period", "freq_hz"] + [f"amplitude_{n}" for n in names]
+        columns += ["max_multiplier"]
+        branch_doc["table_columns"] = columns
+        branch_doc["table"] = np.array(
+            [
+                [p["value"], p["period"], p["freq_hz"]]
+                + [p["amplitude"][n] for n in names]
+                + [np.nan if p["max_multiplier"] is None else p["max_multiplier"]]
+                for p in points
+            ],
+            dtype=np.float64,
+        ).reshape(-1, len(columns))
+        return branch_doc
+    raw = _squeal.hb(
+        *_source(scenario),
+        _sets(set, params),
+        int(harmonics),
+        int(settle_steps),
+        float(settle_time),
+        float(settle_tol),
+        str(guess),
+        _out(out),
     )
+    doc: Dict[str, Any] = json.loads(raw["document"])
+    if raw["out"] is not None:
+        doc["out"] = raw["out"]
+    if "orbit" in raw:
+        doc["orbit_columns"] = list(raw["orbit_columns"])
+        doc["orbit"] = raw["orbit"]
+    return doc
 
 
 def nma(
@@ -952,9 +976,11 @@ def nma(
     ``freq_hz`` (Hz), ``damping_ratio``, ``xi`` (the artificial damping,
     1/s), ``amplitude`` per state, ``residual``, ``sticks``; ``failures``
     and ``warnings``. Lumped and matrix models only (the mass matrix). With
-    ``out``, the CLI's files (``nma.csv``, ``summary.json``, ``nma.png``)."""
+    ``out``, the CLI's files (``nma.csv``, ``summary.json``, ``nma.png``).
+    Besides the document, ``table`` (float64, one row per point, as
+    ``nma.csv`` without ``sticks``) with its ``table_columns``."""
     lo, hi, n = modal_amplitude
-    return dict(
+    doc: Dict[str, Any] = dict(
         json.loads(
             _squeal.nma(
                 *_source(scenario),
@@ -966,6 +992,21 @@ def nma(
             )
         )
     )
+    points = doc["points"]
+    names = list(points[0]["amplitude"]) if points else []
+    columns = ["modal_amplitude", "freq_hz", "xi", "damping_ratio"]
+    columns += [f"amplitude_{s}" for s in names] + ["residual"]
+    doc["table_columns"] = columns
+    doc["table"] = np.array(
+        [
+            [p["modal_amplitude"], p["freq_hz"], p["xi"], p["damping_ratio"]]
+            + [p["amplitude"][s] for s in names]
+            + [p["residual"]]
+            for p in points
+        ],
+        dtype=np.float64,
+    ).reshape(-1, len(columns))
+    return doc
 
 
 def branch(

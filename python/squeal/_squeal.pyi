@@ -87,7 +87,7 @@ def hb(
     settle_tol: float,
     guess: str,
     out: Optional[str] = None,
-) -> str: ...
+) -> Dict[str, Any]: ...
 def hb_branch(
     kind: str,
     text: str,

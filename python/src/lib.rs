@@ -1144,12 +1144,13 @@ fn cycle<'py>(
 }
 
 /// The periodic orbit by harmonic balance (`squeal hb --json`): the
-/// document as JSON text.
+/// document as JSON text, where the output went, and the series over one
+/// period (column names `t` and the states, rows × columns).
 #[pyfunction]
 #[pyo3(signature = (kind, text, sets, harmonics, settle_steps, settle_time, settle_tol, guess, out=None))]
 #[allow(clippy::too_many_arguments)]
-fn hb(
-    py: Python<'_>,
+fn hb<'py>(
+    py: Python<'py>,
     kind: &str,
     text: &str,
     sets: Vec<String>,
@@ -1159,7 +1160,7 @@ fn hb(
     settle_tol: f64,
     guess: &str,
     out: Option<String>,
-) -> PyResult<String> {
+) -> PyResult<Bound<'py, PyDict>> {
     let sc = resolve(kind, text, &sets)?;
     let guess = squeal_study::hb::Guess::parse(guess)
         .map_err(|e| study_err(squeal_study::StudyError::Input(e)))?;
@@ -1169,18 +1170,31 @@ fn hb(
         squeal_study::cycle::checked_options(&sc, settle_steps, settle_time, settle_tol, None)
             .map_err(study_err)?;
     let stage = out.as_deref().map(new_stage).transpose()?;
-    let keep = stage.is_some();
     let found = compute(py, |cancel| {
-        squeal_study::hb::of_scenario(&sc, harmonics, &opts, guess, keep, cancel)
+        squeal_study::hb::of_scenario(&sc, harmonics, &opts, guess, true, cancel)
     })?;
     let mut doc = found.to_json();
     doc["scenario"] = sc.to_json();
-    if let Some(stage) = stage {
-        let write = || squeal_files::hb::write(&stage, &found, &sc, &doc);
-        py.allow_threads(write).map_err(run_err)?;
-        commit(py, stage)?;
+    let dest = match stage {
+        Some(stage) => {
+            let write = || squeal_files::hb::write(&stage, &found, &sc, &doc);
+            py.allow_threads(write).map_err(run_err)?;
+            Some(commit(py, stage)?)
+        }
+        None => None,
+    };
+    let out = PyDict::new(py);
+    out.set_item("document", json_text(&doc)?)?;
+    out.set_item("out", dest)?;
+    if let Some((series, _)) = &found.orbit {
+        let mut names = vec!["t".to_string()];
+        names.extend(found.names.iter().cloned());
+        let table = Array2::from_shape_vec((series.len(), names.len()), series.concat())
+            .map_err(|e| SquealError::new_err(e.to_string()))?;
+        out.set_item("orbit_columns", names)?;
+        out.set_item("orbit", table.into_pyarray(py))?;
     }
-    json_text(&doc)
+    Ok(out)
 }
 
 /// A harmonic-balance solution followed in one parameter (`squeal hb

@@ -1,6 +1,7 @@
 """The Python package against the CLI's own outputs (exact: same bits), its
 shapes, dtypes and errors, determinism over threads, and Ctrl-C."""
 
+import csv
 import json
 import os
 import pathlib
@@ -345,7 +346,19 @@ def test_cycle_and_branch_bad_input_names_the_flag():
 def test_hb_equals_cli_json_and_the_shooting_cycle(cli):
     doc = json.loads(cli("hb", "hoffmann", "--harmonics", "12", "--json"))
     h = squeal.hb("hoffmann", harmonics=12)
+    # Besides the CLI's document, one period of the series as an array.
+    orbit, columns = h.pop("orbit"), h.pop("orbit_columns")
     assert h == doc
+    assert columns[0] == "t" and sorted(columns[1:]) == sorted(h["amplitude"])
+    assert orbit.dtype == np.float64 and orbit.shape == (1025, len(columns))
+    assert orbit[0, 0] == 0.0 and orbit[-1, 0] == pytest.approx(h["period"], rel=1e-12)
+    # Periodic, and its half peak-to-peak is the document's amplitude (the
+    # document samples 4096 points, the array 1024: 1e-3 for these orbits).
+    scale = np.abs(orbit[:, 1:]).max(axis=0)
+    assert np.all(np.abs(orbit[-1, 1:] - orbit[0, 1:]) <= 1e-9 * scale)
+    for j, name in enumerate(columns[1:], start=1):
+        half = 0.5 * (orbit[:, j].max() - orbit[:, j].min())
+        assert half == pytest.approx(h["amplitude"][name], rel=1e-3)
     c = squeal.cycle("hoffmann")
     assert h["freq_hz"] == pytest.approx(c["frequency_hz"], rel=1e-8)
     assert [r["harmonics"] for r in h["convergence"]] == [3, 6, 12]
@@ -364,7 +377,16 @@ def test_hb_forced_response_curve_equals_the_clis(cli, tmp_path):
     # folds: the CLI's document, and the files of out=.
     doc = json.loads(cli("hb", str(DUFFING), "--param", "shaker.freq_hz=10:30:41", "--json"))
     h = squeal.hb(DUFFING, param=("shaker.freq_hz", 10.0, 30.0, 41), out=tmp_path / "frc")
+    table, columns = h.pop("table"), h.pop("table_columns")
     assert h == doc
+    # The table is branch.csv's numbers, row by row.
+    with open(tmp_path / "frc" / "branch.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert table.dtype == np.float64 and table.shape == (len(rows), len(columns))
+    assert columns[:3] == ["shaker.freq_hz", "period", "freq_hz"]
+    for r, row in zip(table, rows):
+        for c, v in zip(columns, r):
+            assert v == pytest.approx(float(row[c]), rel=1e-12), c
     assert h["forced"] is True and len(h["folds"]) == 2
     assert 22.2 < h["folds"][0] < 22.45 and 17.1 < h["folds"][1] < 17.35
     assert json.loads((tmp_path / "frc" / "summary.json").read_text()) == h
@@ -379,7 +401,14 @@ def test_nma_equals_the_clis(cli, tmp_path):
     damper = DUFFING.parent / "friction-damper.toml"
     doc = json.loads(cli("nma", str(damper), "--modal-amplitude", "1e-4:1:7", "--json"))
     n = squeal.nma(damper, modal_amplitude=(1e-4, 1.0, 7), out=tmp_path / "n")
+    table, columns = n.pop("table"), n.pop("table_columns")
     assert n == doc
+    with open(tmp_path / "n" / "nma.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert table.shape == (7, len(columns)) and len(rows) == 7
+    for r, row in zip(table, rows):
+        for c, v in zip(columns, r):
+            assert v == pytest.approx(float(row[c]), rel=1e-12), c
     assert len(n["points"]) == 7 and n["mode"] == 1
     assert (tmp_path / "n" / "nma.csv").read_text().count("\n") == 8
     with pytest.raises(squeal.ScenarioError, match="lumped"):
