@@ -823,6 +823,18 @@ def _write_new_folder(out: str, files: Mapping[str, str]) -> None:
         raise
 
 
+def _orbit_document(raw: Dict[str, Any]) -> Dict[str, Any]:
+    """A binding's answer with an orbit: its JSON document, ``out`` (where
+    the files went, if anywhere) and ``orbit`` with ``orbit_columns``."""
+    doc: Dict[str, Any] = json.loads(raw["document"])
+    if raw["out"] is not None:
+        doc["out"] = raw["out"]
+    if "orbit" in raw:
+        doc["orbit_columns"] = list(raw["orbit_columns"])
+        doc["orbit"] = raw["orbit"]
+    return doc
+
+
 def cycle(
     scenario: Scenario = "disc-pad",
     *,
@@ -852,12 +864,8 @@ def cycle(
         section,
         _out(out),
     )
-    doc: Dict[str, Any] = json.loads(raw["document"])
-    if raw["out"] is not None:
-        doc["out"] = raw["out"]
-    if "orbit" in raw:
-        doc["orbit_columns"] = list(raw["orbit_columns"])
-        doc["orbit"] = raw["orbit"]
+    doc = _orbit_document(raw)
+    if "orbit_events" in raw:
         doc["orbit_events"] = list(raw["orbit_events"])
     return doc
 
@@ -949,13 +957,7 @@ def hb(
         str(guess),
         _out(out),
     )
-    doc: Dict[str, Any] = json.loads(raw["document"])
-    if raw["out"] is not None:
-        doc["out"] = raw["out"]
-    if "orbit" in raw:
-        doc["orbit_columns"] = list(raw["orbit_columns"])
-        doc["orbit"] = raw["orbit"]
-    return doc
+    return _orbit_document(raw)
 
 
 def nma(
