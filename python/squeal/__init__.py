@@ -909,7 +909,9 @@ def hb(
     has ``points`` (per point ``value``, ``freq_hz``, ``period``,
     ``amplitude`` per state, ``max_multiplier``, ``stable``, ``point``:
     ``step`` or ``fold``), ``folds`` (the parameter at each), ``end``,
-    ``start`` (the document at ``LO``) and ``warnings``, and ``table``
+    ``start`` (the document at ``LO``; None when there is no orbit there and
+    the branch starts at ``critical``'s Hopf point in the range, which
+    ``hopf`` then gives as ``value`` and ``freq_hz``) and ``warnings``, and ``table``
     (float64, one row per point, as ``branch.csv`` without ``stable`` and
     ``point``) with its ``table_columns``; ``out`` gets ``branch.csv``,
     ``summary.json`` and ``hb_branch.png``.

@@ -344,16 +344,16 @@ type Search = (UndampedBasis, Option<Vec<f64>>);
 /// Restarts after a Sturm count finds modes the search missed.
 pub const STURM_RESTARTS: usize = 3;
 
-/// [`lowest_modes_at`] (or its result `first`, at the same `sigma`) checked by a Sturm-sequence count: the number of
-/// eigenvalues of `(K_s, M)` below `μ`, taken between the highest mode kept
-/// and the next Ritz value (for a cut-off, at the cut-off itself unless a
-/// mode lies within 10⁻⁶ of it), must equal the modes kept. A Krylov search
-/// can miss a mode whose multiplicity exceeds the block ([`BLOCK`]) or to
-/// which the start block happens to be orthogonal; the count finds that,
-/// and the search is restarted from a fresh block `M`-orthogonal to the
-/// modes found (they are kept, locked, in the basis), at most
-/// [`STURM_RESTARTS`] times. (Ericsson & Ruhe 1980 §4; Grimes, Lewis &
-/// Simon 1994 §3: the FE packages' Lanczos solvers check the same way.)
+/// [`lowest_modes_at`] (or its result `first`, at the same `sigma`)
+/// checked by a Sturm-sequence count: the number of eigenvalues of
+/// `(K_s, M)` below a point of the gap [`sturm_gap`] chooses must equal the
+/// converged Ritz values below it. A Krylov search can miss a mode whose
+/// multiplicity exceeds the block ([`BLOCK`]) or to which the start block
+/// happens to be orthogonal; the count finds that, and the search is
+/// restarted from a fresh block `M`-orthogonal to the modes found (they
+/// are kept, locked, in the basis), at most [`STURM_RESTARTS`] times.
+/// (Ericsson & Ruhe 1980 §4; Grimes, Lewis & Simon 1994 §3: the FE
+/// packages' Lanczos solvers check the same way.)
 fn sturm_checked(
     ks: SparseColMatRef<'_, usize, f64>,
     m: SparseColMatRef<'_, usize, f64>,
@@ -372,8 +372,7 @@ fn sturm_checked(
             return Ok(b);
         };
         let Some((lo, hi, found)) = sturm_gap(&ritz_w2, b.omega2.len(), basis, sigma) else {
-            // The converged Ritz values beyond the kept modes are one
-            // cluster: no gap to count at (left unchecked, sturm_count None).
+            // No gap to count at (left unchecked, sturm_count None).
             return Ok(b);
         };
         let mu = 0.5 * (lo + hi);
@@ -464,8 +463,8 @@ pub fn count_below(
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
     use faer::sparse::linalg::cholesky::{
-        factorize_symbolic_cholesky, simplicial::SimplicialLdltRef, supernodal::SupernodalLdltRef,
-        CholeskySymbolicParams, SymbolicCholeskyRaw, SymmetricOrdering,
+        factorize_symbolic_cholesky, supernodal::SupernodalLdltRef, CholeskySymbolicParams,
+        SymbolicCholeskyRaw, SymmetricOrdering,
     };
     let a = shifted(ks, m, -mu)?;
     let failed = || {
@@ -497,9 +496,7 @@ pub fn count_below(
     let pivots: Vec<f64> = match sym.raw() {
         SymbolicCholeskyRaw::Simplicial(s) => {
             // Each column of the factor starts with its diagonal: D.
-            let l = SimplicialLdltRef::new(s, &values);
-            let col_ptr = l.symbolic().col_ptr();
-            (0..s.nrows()).map(|j| values[col_ptr[j]]).collect()
+            (0..s.nrows()).map(|j| values[s.col_ptr()[j]]).collect()
         }
         SymbolicCholeskyRaw::Supernodal(s) => {
             let l = SupernodalLdltRef::new(s, &values);
@@ -530,9 +527,10 @@ pub fn count_below(
 
 /// [`lowest_modes`] with the shift `sigma` (< 0), unchecked; with the
 /// converged Ritz values `ω²`, ascending (the modes kept and at least a
-/// block beyond; `None`: the basis spans the whole space). `locked`: modes already found (at the same shift), kept
-/// in the basis as its first vectors, the search starting `M`-orthogonal
-/// to them ([`sturm_checked`]'s restart).
+/// block beyond; `None`: the basis spans the whole space). `locked`:
+/// modes already found (at the same shift), kept in the basis as its first
+/// vectors, the search starting `M`-orthogonal to them ([`sturm_checked`]'s
+/// restart).
 fn lowest_modes_at(
     ks: SparseColMatRef<'_, usize, f64>,
     m: SparseColMatRef<'_, usize, f64>,

@@ -58,7 +58,7 @@ fn modal_line(an: &Analysis) -> Option<String> {
     }
 }
 
-/// ", none missed (Sturm count)" when the Lanczos path's count confirmed the modes.
+/// ", none missed: Sturm count" when the Lanczos path's count confirmed the modes.
 fn sturm_words(count: Option<usize>) -> &'static str {
     if count.is_some() {
         ", none missed: Sturm count"
