@@ -890,6 +890,8 @@ def hb(
     (half peak-to-peak, m or m/s); ``harmonics`` per dof (the mean, then
     the amplitude of harmonics 1…H, m); ``contact_modes`` (fraction of the
     period each contact spends in slip+, slip−, stick, free);
+    ``stick_constraint`` (true where the orbit sticks and stick was held as a
+    constraint by the dynamic Lagrangian step);
     ``multipliers`` as ``{re, im, abs, trivial}`` and ``stable`` from one
     exact period from the HB orbit, whose scaled miss is
     ``shooting_defect``; ``convergence`` (rows for H/4, H/2, H:

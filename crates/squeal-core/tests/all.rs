@@ -15,6 +15,7 @@ mod fe_formats;
 mod hb;
 mod hb_forced;
 mod hb_nma;
+mod hb_stick;
 mod lanczos;
 mod lumped;
 mod lumped_lanes;

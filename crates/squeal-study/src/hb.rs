@@ -68,6 +68,9 @@ pub struct HbFound {
     pub spectrum: Vec<Vec<f64>>,
     /// Per contact: name and the fraction of the period in slip+, slip−, stick, no contact.
     pub fractions: Vec<(String, [f64; 4])>,
+    /// Whether stick was a constraint (the dynamic Lagrangian step,
+    /// `squeal_core::hb` module documentation): the orbit sticks.
+    pub stick_constraint: bool,
     /// Mode switches per period.
     pub switches: usize,
     /// Panels per period of the frequency–time step.
@@ -168,12 +171,32 @@ fn amplitude_change(real: &[usize], a: &[f64], b: &[f64]) -> f64 {
 /// HB at `H/4`, `H/2` and `H` from `simulated` (each rung from the last
 /// solution, else from `simulated`; a coarse rung that fails is left out of
 /// the table, with a note): the final orbit, the table, the amplitudes.
+/// With `stick`, stick is a constraint (the dynamic Lagrangian step);
+/// without it, an orbit found to stick is solved again with it.
 #[allow(clippy::type_complexity)]
 fn ladder<M: System<N> + ?Sized, const N: usize>(
     m: &M,
     simulated: &Fourier,
     harmonics: usize,
     real: &[usize],
+    stick: bool,
+    cancel: &Cancel,
+) -> Result<(HbOrbit, Vec<Truncation>, [f64; N], Vec<String>), StudyError> {
+    let found = rungs(m, simulated, harmonics, real, stick, cancel)?;
+    if !stick && found.0.sticks {
+        return rungs(m, simulated, harmonics, real, true, cancel);
+    }
+    Ok(found)
+}
+
+/// The rungs of [`ladder`] with stick as a constraint or not.
+#[allow(clippy::type_complexity)]
+fn rungs<M: System<N> + ?Sized, const N: usize>(
+    m: &M,
+    simulated: &Fourier,
+    harmonics: usize,
+    real: &[usize],
+    stick: bool,
     cancel: &Cancel,
 ) -> Result<(HbOrbit, Vec<Truncation>, [f64; N], Vec<String>), StudyError> {
     let mut rungs = vec![(harmonics / 4).max(1), (harmonics / 2).max(1), harmonics];
@@ -185,6 +208,7 @@ fn ladder<M: System<N> + ?Sized, const N: usize>(
     for &h in &rungs {
         let hb_opts = HbOptions {
             harmonics: h,
+            lagrangian: stick,
             ..HbOptions::default()
         };
         // From the last truncation's solution, else from the simulation
@@ -353,7 +377,8 @@ fn from_hopf<M: System<N> + ?Sized, const N: usize>(
         let Some(g) = hopf_guess(m, real, factor, true)? else {
             return Ok(None);
         };
-        let Ok((o, conv, amp, notes)) = ladder(m, &g.resized(harmonics), harmonics, real, cancel)
+        let Ok((o, conv, amp, notes)) =
+            ladder(m, &g.resized(harmonics), harmonics, real, false, cancel)
         else {
             continue;
         };
@@ -436,16 +461,11 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
             spent += settled;
             cancel.check()?;
             let orbit = cycle::sample_period(m, &zs, period, opts).map_err(cycle_err)?;
-            if let Some(k) = orbit.modes.iter().find_map(|md| {
-                md.as_slice()
-                    .iter()
-                    .position(|&x| x == squeal_core::Mode::Stick)
-            }) {
-                return Err(StudyError::Input(InputError(format!(
-                "hb: the orbit the scenario settles on sticks (contact {}): harmonic balance here treats friction as slip and contact loss exactly, but a sticking contact's force is a constraint force (a dynamic Lagrangian scheme, not built); use squeal cycle",
-                m.contact_name(k)
-            ))));
-            }
+            // A settled orbit that sticks: stick as a constraint.
+            let sticks = orbit
+                .modes
+                .iter()
+                .any(|md| md.as_slice().contains(&squeal_core::Mode::Stick));
             // Fitted with enough harmonics to see whether the settled "period"
             // is several turns of the orbit (the turns of a settling run agree
             // to its tolerance only: up to 1e-2 of the energy may leak into
@@ -461,7 +481,7 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
             let mut best = None;
             let mut failure = None;
             for g in &guesses {
-                match ladder(m, g, harmonics, &real, cancel) {
+                match ladder(m, g, harmonics, &real, sticks, cancel) {
                     Ok((o, conv, amp, notes)) => {
                         let z_hb: [f64; N] = o.fourier.state(0.0);
                         let c =
@@ -663,7 +683,7 @@ fn finish<M: System<N> + ?Sized, const N: usize>(
             HbOptions::default().newton_tol
         ));
     }
-    if o.sticks {
+    if o.sticks && !o.lagrangian {
         warnings.push(
             "a contact sticks on the orbit: harmonic balance treats stick as slip at zero speed, not as a constraint; use squeal cycle".into(),
         );
@@ -707,6 +727,7 @@ fn finish<M: System<N> + ?Sized, const N: usize>(
             })
             .collect(),
         fractions: contacts,
+        stick_constraint: o.lagrangian,
         switches: o.switches,
         panels: o.panels,
         multipliers: st.multipliers,
@@ -782,7 +803,11 @@ fn solve_forced<M: System<N> + ?Sized, const N: usize>(
     }
     let orbit = cycle::sample_period(m, &z, period, opts).map_err(cycle_err)?;
     let guess = Fourier::from_orbit(&orbit, period, n, harmonics);
-    let (o, convergence, amp, notes) = ladder(m, &guess, harmonics, &real, cancel)?;
+    let sticks = orbit
+        .modes
+        .iter()
+        .any(|md| md.as_slice().contains(&squeal_core::Mode::Stick));
+    let (o, convergence, amp, notes) = ladder(m, &guess, harmonics, &real, sticks, cancel)?;
     let z_hb: [f64; N] = o.fourier.state(0.0);
     let (list, defect, events) =
         cycle::forced_floquet(m, &z_hb, period, opts).map_err(cycle_err)?;
@@ -839,8 +864,8 @@ impl HbFound {
     /// (`period`, `frequency_hz`, `amplitude`, `stable`, `multipliers`,
     /// `max_multiplier`, `events_per_period`) plus `freq_hz`, `harmonics`
     /// (per dof: mean, then the amplitude of each harmonic, m),
-    /// `harmonic_count`, `contact_modes`, `convergence`, `shooting_defect`
-    /// and `warnings`.
+    /// `harmonic_count`, `contact_modes`, `stick_constraint`, `convergence`,
+    /// `shooting_defect` and `warnings`.
     pub fn to_json(&self) -> Value {
         let mut modes = Map::new();
         for (name, f) in &self.fractions {
@@ -879,6 +904,7 @@ impl HbFound {
             "events_per_period": events_json(&self.events),
             "shooting_defect": self.defect,
             "contact_modes": modes,
+            "stick_constraint": self.stick_constraint,
             "switches_per_period": self.switches,
             "panels": self.panels,
             "convergence": convergence,

@@ -176,6 +176,7 @@ pub fn hb_branch_from<const N: usize>(
             omega0: f0.omega,
             phase_dof: None,
             mode: None,
+            lagrangian: opts.hb.lagrangian.then_some(opts.hb.lagrangian_weight),
         }
     } else {
         let amp = harmonic_amplitudes(&f0);
@@ -200,6 +201,7 @@ pub fn hb_branch_from<const N: usize>(
             omega0: f0.omega,
             phase_dof: Some(phase_dof),
             mode: None,
+            lagrangian: opts.hb.lagrangian.then_some(opts.hb.lagrangian_weight),
         }
     };
     let m = lay.unknowns();

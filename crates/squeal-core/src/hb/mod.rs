@@ -34,10 +34,17 @@
 //! are direct sums, `n·(2H+1)` per node, rather than an FFT; at the sizes
 //! HB is used for this is not the cost that matters.)
 //!
-//! **Stick is not handled.** In stick the friction force is a constraint
-//! force, not a function of the state; a sampled orbit whose sliding
-//! velocity merely touches zero is reported by [`HbOrbit::sticks`] and the
-//! callers refuse it (a dynamic Lagrangian scheme would be needed).
+//! # Stick: the dynamic Lagrangian step
+//!
+//! In stick the friction force is a constraint force, not a function of
+//! the state. With [`HbOptions::lagrangian`] every phase's friction forces
+//! are predicted from the series and the stick-or-slip rules decide each
+//! contact's mode there (module `lagrangian`: a dynamic Lagrangian
+//! frequency–time step in the velocities, whose limit as `H` grows is the
+//! exact non-smooth law, static and kinetic coefficients apart); the
+//! switching phases are found and integrated across as above. Without it a
+//! sampled orbit whose sliding velocity merely touches zero is reported by
+//! [`HbOrbit::sticks`], and callers refuse it.
 //!
 //! References: Krack & Gross, *Harmonic Balance for Nonlinear Vibration
 //! Problems* (Springer 2019), ch. 2–4 (HB, AFT, autonomous systems and the
@@ -45,6 +52,7 @@
 //! (alternating frequency–time).
 
 pub mod continuation;
+mod lagrangian;
 pub mod nma;
 
 use crate::cycle::{autonomous_from, real_indices};
@@ -71,6 +79,16 @@ pub struct HbOptions {
     pub newton_tol: f64,
     /// Most Newton iterations.
     pub newton_iterations: usize,
+    /// Stick as a constraint: the dynamic Lagrangian step of
+    /// [module documentation](self#stick-the-dynamic-lagrangian-step) decides stick
+    /// or slip at every phase and gives a sticking contact its constraint
+    /// force. Off, friction is slip at the sign of the sliding velocity
+    /// (exact for orbits that never stick, and cheaper).
+    pub lagrangian: bool,
+    /// Factor on the dynamic Lagrangian step's weight `ε = ω/|g·b|` (1 by
+    /// default). The exact orbit solves the equations for any `ε > 0`; at
+    /// finite `H` the orbit moves slightly with it (measured in the tests).
+    pub lagrangian_weight: f64,
 }
 
 impl Default for HbOptions {
@@ -80,6 +98,8 @@ impl Default for HbOptions {
             panels: 0,
             newton_tol: 1e-10,
             newton_iterations: 40,
+            lagrangian: false,
+            lagrangian_weight: 1.0,
         }
     }
 }
@@ -268,23 +288,25 @@ impl Fourier {
 
     /// Position and velocity of every real dof at phase `θ`.
     pub fn eval(&self, theta: f64, q: &mut [f64], v: &mut [f64]) {
-        let h = self.harmonics();
-        let (s1, c1) = theta.sin_cos();
+        let sc = theta.sin_cos();
         for (i, c) in self.coeffs.iter().enumerate() {
-            let (mut x, mut dx) = (c[0], 0.0);
-            let (mut ck, mut sk) = (1.0, 0.0);
-            for k in 1..=h {
-                // cos kθ, sin kθ by the angle-addition recurrence.
-                let (cn, sn) = (ck * c1 - sk * s1, sk * c1 + ck * s1);
-                ck = cn;
-                sk = sn;
-                let (a, b) = (c[2 * k - 1], c[2 * k]);
-                x += a * ck + b * sk;
-                dx += k as f64 * (b * ck - a * sk);
-            }
+            let (x, dx, _) = series_at(c, sc);
             q[i] = x;
             v[i] = self.omega * dx;
         }
+    }
+
+    /// Velocity and acceleration of every real dof at phase `θ`, as the
+    /// rates `ż = (q̇, q̈)` of the full state (`N` states, idle ones zero).
+    pub fn rates<const N: usize>(&self, theta: f64) -> [f64; N] {
+        let sc = theta.sin_cos();
+        let mut out = [0.0; N];
+        for (i, c) in self.coeffs.iter().enumerate() {
+            let (_, dx, ddx) = series_at(c, sc);
+            out[i] = self.omega * dx;
+            out[N / 2 + i] = self.omega * self.omega * ddx;
+        }
+        out
     }
 
     /// The full state (`N` states, a padded model's idle ones at rest) at `θ`.
@@ -295,6 +317,26 @@ impl Fourier {
         self.eval(theta, &mut q[..n], &mut v[..n]);
         z
     }
+}
+
+/// One dof's series `c = [a₀, a₁, b₁, …]` at the phase whose `(sin θ,
+/// cos θ)` is `sc`: `(q, dq/dθ, d²q/dθ²)`, with `cos kθ`, `sin kθ` by the
+/// angle-addition recurrence.
+#[inline]
+fn series_at(c: &[f64], (s1, c1): (f64, f64)) -> (f64, f64, f64) {
+    let (mut x, mut dx, mut ddx) = (c[0], 0.0, 0.0);
+    let (mut ck, mut sk) = (1.0, 0.0);
+    for k in 1..=(c.len() - 1) / 2 {
+        let (cn, sn) = (ck * c1 - sk * s1, sk * c1 + ck * s1);
+        ck = cn;
+        sk = sn;
+        let (a, b) = (c[2 * k - 1], c[2 * k]);
+        let kf = k as f64;
+        x += a * ck + b * sk;
+        dx += kf * (b * ck - a * sk);
+        ddx -= kf * kf * (a * ck + b * sk);
+    }
+    (x, dx, ddx)
 }
 
 /// A converged harmonic-balance orbit.
@@ -311,8 +353,12 @@ pub struct HbOrbit {
     pub fractions: Vec<[f64; 4]>,
     /// Mode switches per period (all contacts).
     pub switches: usize,
-    /// Whether a sampled state of the orbit sticks (the scheme is then not exact).
+    /// Whether a contact sticks somewhere on the orbit: exact with
+    /// [`HbOrbit::lagrangian`]; without it, a sampled state whose sliding
+    /// velocity is exactly zero (the scheme is then not exact).
     pub sticks: bool,
+    /// Whether stick was a constraint (the dynamic Lagrangian step).
+    pub lagrangian: bool,
     /// Panels per period used.
     pub panels: usize,
     /// False if Newton's method stalled above the tolerance but within
@@ -359,6 +405,9 @@ pub(crate) struct Layout {
     /// damping `ξ` is one more unknown, and the phase and amplitude
     /// conditions are the mode's ([`nma`]).
     pub(crate) mode: Option<ModeNorm>,
+    /// Stick by the dynamic Lagrangian step ([`HbOptions::lagrangian`]):
+    /// `Some(weight)`, the factor on its `ε`.
+    pub(crate) lagrangian: Option<f64>,
 }
 
 impl Layout {
@@ -500,8 +549,13 @@ impl<'a, S: System<N> + ?Sized, const N: usize> Balance<'a, S, N> {
     }
 
     fn modes_at(&self, f: &Fourier, theta: f64) -> Modes {
+        let t = self.time(f.omega, theta);
+        if let Some(w) = self.lay.lagrangian {
+            let mut dz = [0.0; N];
+            return lagrangian::point(self.sys, f, t, theta, w, None, &mut dz);
+        }
         let z: [f64; N] = f.state(theta);
-        self.sys.start_modes(self.time(f.omega, theta), &z)
+        self.sys.start_modes(t, &z)
     }
 
     /// The smooth pieces of the period: panels, split where the modes change.
@@ -583,8 +637,12 @@ impl<'a, S: System<N> + ?Sized, const N: usize> Balance<'a, S, N> {
                 let th = mid + half * xg;
                 let wt = half * wg;
                 let z: [f64; N] = f.state(th);
-                self.sys
-                    .field(self.time(f.omega, th), &pc.modes, &z, &mut dz);
+                let t = self.time(f.omega, th);
+                if let Some(w) = self.lay.lagrangian {
+                    lagrangian::point(self.sys, f, t, th, w, Some(&pc.modes), &mut dz);
+                } else {
+                    self.sys.field(t, &pc.modes, &z, &mut dz);
+                }
                 let (s1, c1) = th.sin_cos();
                 cs[0] = (1.0, 0.0);
                 for k in 1..=h {
@@ -673,6 +731,7 @@ impl<'a, S: System<N> + ?Sized, const N: usize> Balance<'a, S, N> {
             fractions,
             switches,
             sticks,
+            lagrangian: self.lay.lagrangian.is_some(),
             panels: self.lay.panels,
             converged,
         }
@@ -909,6 +968,7 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
         omega0: guess.omega,
         phase_dof: Some(phase_dof),
         mode: None,
+        lagrangian: opts.lagrangian.then_some(opts.lagrangian_weight),
     };
     let bal = Balance::<S, N>::new(sys, &lay)?;
     let m = lay.unknowns();
@@ -980,6 +1040,7 @@ pub fn forced_response<S: System<N> + ?Sized, const N: usize>(
         omega0: omega,
         phase_dof: None,
         mode: None,
+        lagrangian: opts.lagrangian.then_some(opts.lagrangian_weight),
     };
     let bal = Balance::<S, N>::new(sys, &lay)?;
     let res = |x: &[f64], out: &mut [f64]| bal.residual(x, out);

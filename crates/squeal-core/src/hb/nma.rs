@@ -116,6 +116,7 @@ pub fn nonlinear_mode<S: crate::model::System<N> + ?Sized, const N: usize>(
             m_phi,
             amplitude,
         }),
+        lagrangian: opts.lagrangian.then_some(opts.lagrangian_weight),
     };
     let bal = Balance::<S, N>::new(sys, &lay)?;
     let m = lay.unknowns();

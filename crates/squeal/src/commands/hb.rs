@@ -169,6 +169,11 @@ fn print_rest(f: &HbFound) {
             fr[3]
         );
     }
+    if f.stick_constraint {
+        crate::outln!(
+            "stick as a constraint (dynamic Lagrangian step): converges algebraically in the harmonics"
+        );
+    }
     let n = f.spectrum.len();
     let show = f.harmonics.min(5);
     crate::outln!("amplitude per dof and harmonic (m; mean, then k = 1…{show}):");
