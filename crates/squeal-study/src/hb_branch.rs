@@ -16,8 +16,10 @@ use rayon::prelude::*;
 use serde_json::{json, Value};
 use squeal_core::cycle::continuation::{Reparametrise, Varied};
 use squeal_core::cycle::{self, CycleOptions};
-use squeal_core::hb::continuation::{hb_branch_from, BranchStart, HbBranchEnd, HbBranchOptions};
-use squeal_core::hb::{HbError, HbOptions};
+use squeal_core::hb::continuation::{
+    hb_branch_from, BranchStart, HbBranch, HbBranchEnd, HbBranchOptions,
+};
+use squeal_core::hb::{forced_response, harmonic_balance, HbError, HbOptions};
 use squeal_core::stability::Crossing;
 use squeal_core::System;
 
@@ -39,6 +41,9 @@ pub struct HbBranchRow {
     pub resolved: bool,
     /// Scaled HB residual.
     pub residual: f64,
+    /// Whether stick was imposed as a constraint (the dynamic Lagrangian
+    /// step) at this point, rather than friction balanced as slip.
+    pub stick_constraint: bool,
     /// `step`, or `fold` for the point nearest a fold.
     pub kind: &'static str,
 }
@@ -198,11 +203,17 @@ fn follow_in<M: System<N> + Reparametrise<N> + ?Sized, const N: usize>(
             }
             (None, None) => unreachable!("follow gives a start or a Hopf point"),
         };
-        let br =
+        let mut br =
             hb_branch_from(&guarded, lo, hi, steps, &series, from, bopts).map_err(|e| match e {
                 HbError::Bad(m) => StudyError::Input(InputError(format!("hb --param: {m}"))),
                 other => StudyError::Numerical(format!("hb --param: {other}")),
             })?;
+        cancel.check()?;
+        let stick_from = if bopts.hb.lagrangian {
+            None
+        } else {
+            with_stick(&guarded, &mut br, lo, hi, steps, bopts)
+        };
         cancel.check()?;
         let forced = start.as_ref().is_some_and(|s| s.forcing_hz.is_some());
         // Each point's stability by one exact period (independent, in
@@ -243,6 +254,11 @@ fn follow_in<M: System<N> + Reparametrise<N> + ?Sized, const N: usize>(
             })
             .collect();
         let mut warnings = start.as_ref().map_or_else(Vec::new, |s| s.warnings.clone());
+        if let Some(p) = stick_from {
+            warnings.push(format!(
+                "from {name} = {p} on (where the branch stalled with friction as slip) the branch was continued with stick as a constraint (dynamic Lagrangian step); its convergence in the harmonics is algebraic"
+            ));
+        }
         let mut rows = Vec::with_capacity(br.points.len());
         for (k, (pt, st)) in br.points.iter().zip(stab).enumerate() {
             let (max, stable, resolved) = match st {
@@ -261,9 +277,10 @@ fn follow_in<M: System<N> + Reparametrise<N> + ?Sized, const N: usize>(
                 stable,
                 resolved,
                 residual: pt.orbit.residual,
+                stick_constraint: pt.orbit.lagrangian,
                 kind: if fold_at.contains(&k) { "fold" } else { "step" },
             });
-            if pt.orbit.sticks {
+            if pt.orbit.sticks && !pt.orbit.lagrangian {
                 warnings.push(format!(
                     "{name} = {}: a contact sticks on the orbit (harmonic balance treats stick as slip at zero speed)",
                     pt.p
@@ -286,11 +303,60 @@ fn follow_in<M: System<N> + Reparametrise<N> + ?Sized, const N: usize>(
     }
 }
 
+/// A branch that stalled with friction as slip (an orbit beginning to
+/// stick, say), continued from its last point to `hi` with stick as a
+/// constraint (`HbOptions::lagrangian`), at the same largest step; the
+/// value it was continued from, if the second leg added a point.
+fn with_stick<const N: usize>(
+    family: &(dyn squeal_core::cycle::continuation::Family<N> + Sync),
+    br: &mut HbBranch,
+    lo: f64,
+    hi: f64,
+    steps: usize,
+    bopts: &HbBranchOptions,
+) -> Option<f64> {
+    if !matches!(br.end, HbBranchEnd::Stalled(..)) {
+        return None;
+    }
+    let last = br.points.last()?;
+    let dp = (hi - lo) / (steps - 1) as f64;
+    let rest = (hi - last.p) / dp;
+    if rest.is_nan() || rest <= 0.5 {
+        return None;
+    }
+    let steps2 = (rest.ceil() as usize + 1).max(2);
+    let mut b2 = *bopts;
+    b2.hb.lagrangian = true;
+    // The last orbit solved again with stick as a constraint: the start.
+    let mut solved = None;
+    family
+        .visit(last.p, &mut |sys| {
+            solved = Some(if sys.forcing_hz().is_empty() {
+                harmonic_balance(sys, &last.orbit.fourier, &b2.hb)
+            } else {
+                forced_response(sys, &last.orbit.fourier, &b2.hb)
+            });
+        })
+        .ok()?;
+    let start = solved?.ok()?.fourier;
+    let leg = hb_branch_from(family, last.p, hi, steps2, &start, BranchStart::Lo, &b2).ok()?;
+    if leg.points.len() < 2 {
+        return None;
+    }
+    let from = last.p;
+    let off = br.points.len() - 1;
+    br.folds
+        .extend(leg.folds.iter().map(|&(k, p)| (k + off, p)));
+    br.points.extend(leg.points.into_iter().skip(1));
+    br.end = leg.end;
+    Some(from)
+}
+
 impl HbBranchFound {
     /// The JSON document: `param`, `forced`, `harmonic_count`, `points`
     /// (per point `value`, `period`, `freq_hz`, `amplitude` per state,
     /// `max_multiplier`, `stable`, `stability_resolved`, `residual`,
-    /// `point`), `folds`, `end`, `start` (`squeal hb`'s document at the
+    /// `stick_constraint`, `point`), `folds`, `end`, `start` (`squeal hb`'s document at the
     /// first value; null when there is no orbit there), `hopf` (`value`,
     /// `freq_hz` of the Hopf point the branch started at, or null) and
     /// `warnings`.
@@ -308,6 +374,7 @@ impl HbBranchFound {
                     "stable": r.stable,
                     "stability_resolved": r.resolved,
                     "residual": r.residual,
+                    "stick_constraint": r.stick_constraint,
                     "point": r.kind,
                 })
             })

@@ -400,9 +400,9 @@ fn the_friction_dampers_nonlinear_mode() {
 /// stable there), the branch starts at `critical`'s Hopf point inside the
 /// range. On the belt with the (exponential) Stribeck law the Hopf point is
 /// generic, so near it the amplitude grows as `A² ∝ p − p_h` (the normal
-/// form), the orbit has the critical mode's frequency, and it ends where
-/// its velocity amplitude reaches the belt speed (stick, which HB does not
-/// balance).
+/// form), the orbit has the critical mode's frequency, and the branch of
+/// pure slip ends where its velocity amplitude reaches the belt speed; it
+/// goes on with stick as a constraint.
 #[test]
 fn hb_param_starts_at_the_hopf_point_when_lo_has_no_orbit() {
     let d = tempfile::tempdir().unwrap();
@@ -444,10 +444,32 @@ fn hb_param_starts_at_the_hopf_point_when_lo_has_no_orbit() {
     // (V₂ − V_h)/(V₁ − V_h) = (A₂/A₁)² near the Hopf point (3 %).
     let law = ((v2 - vh) / (v1 - vh)) / (a2 / a1).powi(2);
     assert!((law - 1.0).abs() < 0.03, "A² law off by {law}");
-    // The last orbit's velocity amplitude ωA has reached the belt speed.
-    let (vl, al, fl) = at(pts.len() - 1);
-    let speed = std::f64::consts::TAU * fl * al;
-    assert!((speed - vl).abs() <= 2e-3 * vl, "{speed} vs {vl}");
+    // The branch of pure slip stalls where the orbit's velocity amplitude
+    // ωA reaches the belt speed; from there it goes on with stick imposed
+    // as a constraint, to the range's end, where the orbit is stick-slip:
+    // ωA stays near V (the slip phase's speed amplitude, 1 %).
+    let slip = pts
+        .iter()
+        .take_while(|p| p["stick_constraint"] == false)
+        .count();
+    assert!(slip >= 3 && slip < pts.len(), "{br}");
+    let speed = |k: usize| {
+        let (v, a, f) = at(k);
+        (std::f64::consts::TAU * f * a, v)
+    };
+    let (s, v) = speed(slip - 1);
+    assert!((s - v).abs() <= 2e-3 * v, "{s} vs {v}");
+    assert!(br["end"].as_str().unwrap().starts_with("reached"), "{br}");
+    assert!(pts[slip..].iter().all(|p| p["stick_constraint"] == true));
+    let (s, v) = speed(pts.len() - 1);
+    assert!(
+        (v - 0.1).abs() < 1e-12 && (s - v).abs() <= 1e-2 * v,
+        "{s} vs {v}"
+    );
+    assert!(br["warnings"][0]
+        .as_str()
+        .unwrap()
+        .contains("continued with stick as a constraint"));
 }
 
 /// Hoffmann's model: no orbit at μ = 0.1, the branch from its Hopf point
@@ -489,4 +511,43 @@ fn hb_param_from_the_hopf_point_equals_shooting_on_the_branch() {
         cy["amplitude"]["y"].as_f64().unwrap(),
     );
     assert!((ah - ac).abs() <= 1e-4 * ac, "{ah} vs {ac}");
+    // From μ ≈ 0.3102 the orbit sticks: the branch goes on to the range's
+    // end with stick as a constraint, and says so. Near μ = 0.4 (stick 12 %,
+    // no contact 48 % of the period) its frequency is shooting's to 5.4e-4
+    // at H = 20 (the amplitude of y to 6 %; `hb --harmonics 80` there: 7.5e-5
+    // and 0.8 %, the algebraic convergence of stick with contact loss).
+    assert!(
+        br["end"].as_str().unwrap().contains("reached"),
+        "{}",
+        br["end"]
+    );
+    assert!(
+        br["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("stick as a constraint")),
+        "{}",
+        br["warnings"]
+    );
+    let p = br["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .min_by(|a, b| {
+            let d = |p: &serde_json::Value| (p["value"].as_f64().unwrap() - 0.4).abs();
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap();
+    let mu = p["value"].as_f64().unwrap();
+    assert!((mu - 0.4).abs() < 0.02, "{mu}");
+    let cy = json_of(&squeal(
+        d.path(),
+        &["cycle", "hoffmann", "--set", &format!("mu={mu}"), "--json"],
+    ));
+    let (fh, fc) = (
+        p["freq_hz"].as_f64().unwrap(),
+        cy["frequency_hz"].as_f64().unwrap(),
+    );
+    assert!((fh - fc).abs() <= 1e-3 * fc, "μ = {mu}: {fh} vs {fc}");
 }

@@ -87,8 +87,14 @@ impl<const N: usize> System<N> for Lumped {
                         (GuardKind::StickBreakPos, 1.0),
                         (GuardKind::StickBreakNeg, -1.0),
                     ] {
-                        // The (linear part's) gradient by unit evaluations: exact for an affine function.
-                        let t = f64::INFINITY;
+                        // The (linear part's) gradient by unit evaluations: exact for an affine
+                        // function. At a finite time: a force that varies in time adds the same
+                        // term to every evaluation (and cancels), but a harmonic one is NaN at
+                        // t = ∞, which made the gradient, the guard's slope bound and so every
+                        // event search of a forced model in stick NaN (the step then shrank to
+                        // underflow). The constant `d` is used only by affine guards, which have
+                        // no time-varying force.
+                        let t = 0.0;
                         let zero = [0.0; N];
                         let d = self.stick_guard(t, modes, i, sign, &zero, affine_stick);
                         let mut g = [0.0; N];
