@@ -14,7 +14,6 @@ mod equilibrium;
 mod fe_formats;
 mod hb;
 mod hb_forced;
-mod hb_hill;
 mod hb_nma;
 mod hb_stick;
 mod lanczos;
