@@ -308,6 +308,16 @@ fn last_period(l: &Lumped, hz: f64, periods: usize, per: usize) -> Vec<f64> {
     rec.z[n - 1 - per..n - 1].iter().map(|z| z[0]).collect()
 }
 
+/// Half peak-to-peak of samples.
+fn half_range(x: &[f64]) -> f64 {
+    let (lo, hi) = x
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
+    0.5 * (hi - lo)
+}
+
 /// Forced oscillators that stick. Regression: a harmonic force made the
 /// stick guards' linear part NaN (it was taken at t = ∞), so the event
 /// search of every forced model in stick failed and the step size
@@ -323,25 +333,15 @@ fn forced_oscillators_that_stick_simulate_and_balance() {
     let (f, r) = (10.0, 0.6);
     let hz = r * w0 / TAU;
     let x = last_period(&oscillator(m, k, 0.0, 0.0, f, hz, Some(ff)), hz, 60, 4000);
-    let (lo, hi) = x
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(*v), b.max(*v))
-        });
     let exact = den_hartog(r, ff / f) * f / k;
-    let sim = 0.5 * (hi - lo);
+    let sim = half_range(&x);
     eprintln!("r = 0.6: simulated {sim:.9e}, exact {exact:.9e}");
     assert!((sim / exact - 1.0).abs() < 1e-4, "{sim} vs {exact}");
     // F = 5 N at 8 Hz: stops. HB from the simulated period.
     let (f, hz) = (5.0, 8.0);
     let l = oscillator(m, k, 0.0, 0.0, f, hz, Some(ff));
     let x = last_period(&l, hz, 40, 4000);
-    let (lo, hi) = x
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(*v), b.max(*v))
-        });
-    let sim = 0.5 * (hi - lo);
+    let sim = half_range(&x);
     let sys = Fixed::<2>(&l);
     let mut g = Fourier::fit(TAU * hz, &[x], 10);
     let mut errs = Vec::new();

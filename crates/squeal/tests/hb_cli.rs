@@ -486,21 +486,27 @@ fn hb_param_from_the_hopf_point_equals_shooting_on_the_branch() {
     let mu_c = br["hopf"]["value"].as_f64().unwrap();
     assert!((mu_c - 0.2501375).abs() < 1e-6, "{mu_c}");
     assert_eq!(br["folds"].as_array().unwrap().len(), 0, "{br}");
-    let p = br["points"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .min_by(|a, b| {
-            let d = |p: &serde_json::Value| (p["value"].as_f64().unwrap() - 0.3).abs();
-            d(a).total_cmp(&d(b))
-        })
-        .unwrap();
-    let mu = p["value"].as_f64().unwrap();
+    // The branch's point nearest μ = `target`, and `squeal cycle` there.
+    let near = |target: f64| {
+        let p = br["points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .min_by(|a, b| {
+                let d = |p: &serde_json::Value| (p["value"].as_f64().unwrap() - target).abs();
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap()
+            .clone();
+        let mu = p["value"].as_f64().unwrap();
+        let cy = json_of(&squeal(
+            d.path(),
+            &["cycle", "hoffmann", "--set", &format!("mu={mu}"), "--json"],
+        ));
+        (mu, p, cy)
+    };
+    let (mu, p, cy) = near(0.3);
     assert!((mu - 0.3).abs() < 0.01, "{mu}");
-    let cy = json_of(&squeal(
-        d.path(),
-        &["cycle", "hoffmann", "--set", &format!("mu={mu}"), "--json"],
-    ));
     let (fh, fc) = (
         p["freq_hz"].as_f64().unwrap(),
         cy["frequency_hz"].as_f64().unwrap(),
@@ -530,21 +536,8 @@ fn hb_param_from_the_hopf_point_equals_shooting_on_the_branch() {
         "{}",
         br["warnings"]
     );
-    let p = br["points"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .min_by(|a, b| {
-            let d = |p: &serde_json::Value| (p["value"].as_f64().unwrap() - 0.4).abs();
-            d(a).total_cmp(&d(b))
-        })
-        .unwrap();
-    let mu = p["value"].as_f64().unwrap();
+    let (mu, p, cy) = near(0.4);
     assert!((mu - 0.4).abs() < 0.02, "{mu}");
-    let cy = json_of(&squeal(
-        d.path(),
-        &["cycle", "hoffmann", "--set", &format!("mu={mu}"), "--json"],
-    ));
     let (fh, fc) = (
         p["freq_hz"].as_f64().unwrap(),
         cy["frequency_hz"].as_f64().unwrap(),
