@@ -27,8 +27,8 @@
 //! §3.4: `p − p_h ∝ A²` on either side), then followed as above.
 
 use super::{
-    fd_jacobian, forced_scales, forcing_omega, harmonic_amplitudes, newton, Balance, Fourier,
-    HbError, HbOptions, HbOrbit, Layout,
+    forced_scales, forcing_omega, harmonic_amplitudes, newton, Balance, Fourier, HbError,
+    HbOptions, HbOrbit, Layout,
 };
 use crate::cycle::continuation::Family;
 use nalgebra::{DMatrix, DVector};
@@ -226,8 +226,7 @@ pub fn hb_branch_from<const N: usize>(
         let mut jx = DMatrix::<f64>::from_element(m, m, f64::NAN);
         let _ = family.visit(p, &mut |sys| {
             if let Ok(bal) = Balance::new(sys, &lay) {
-                let res = |x: &[f64], out: &mut [f64]| bal.residual(x, out);
-                jx = fd_jacobian(&res, &xx[..m], &r[..m]);
+                jx = bal.jacobian(&xx[..m], &r[..m]);
             }
         });
         let dh = 1e-7 * xx[m].abs().max(1.0);
@@ -407,7 +406,15 @@ pub fn hb_branch_from<const N: usize>(
                 full.push(end);
                 residual(&full, o);
             };
-            let fixed_jac = |xs: &[f64], r: &[f64]| fd_jacobian(&fixed, xs, r);
+            let fixed_jac = |xs: &[f64], r: &[f64]| {
+                let mut jx = DMatrix::<f64>::from_element(m, m, f64::NAN);
+                let _ = family.visit(param(end), &mut |sys| {
+                    if let Ok(bal) = Balance::new(sys, &lay) {
+                        jx = bal.jacobian(xs, r);
+                    }
+                });
+                jx
+            };
             match newton(
                 &fixed,
                 &fixed_jac,

@@ -14,7 +14,9 @@
 //! closed by the phase condition `b₁ = 0` of the dof with the largest first
 //! harmonic (the time origin of an autonomous orbit is free): `n(2H+1)+1`
 //! equations for the `n(2H+1)` coefficients and `ω`, solved by Newton's
-//! method with a finite-difference Jacobian and a backtracking line search.
+//! method with a backtracking line search and the Jacobian assembled from
+//! the field's own derivatives at the quadrature nodes and the motion of the
+//! switching phases (module `jacobian`).
 //!
 //! **The frequency–time step, exact at switches.** The classic alternating
 //! frequency–time scheme samples `a` at equidistant times and takes an FFT.
@@ -52,6 +54,7 @@
 //! (alternating frequency–time).
 
 pub mod continuation;
+mod jacobian;
 mod lagrangian;
 pub mod nma;
 
@@ -975,7 +978,7 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
     let res = |x: &[f64], out: &mut [f64]| bal.residual(x, out);
     let solved = newton(
         &res,
-        &|x, r| fd_jacobian(&res, x, r),
+        &|x, r| bal.jacobian(x, r),
         &|x| x[m - 1] > 0.0,
         lay.to_x(&guess),
         opts.newton_tol,
@@ -1046,7 +1049,7 @@ pub fn forced_response<S: System<N> + ?Sized, const N: usize>(
     let res = |x: &[f64], out: &mut [f64]| bal.residual(x, out);
     let solved = newton(
         &res,
-        &|x, r| fd_jacobian(&res, x, r),
+        &|x, r| bal.jacobian(x, r),
         &|_| true,
         lay.to_x(&guess),
         opts.newton_tol,

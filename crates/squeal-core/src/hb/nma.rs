@@ -20,8 +20,8 @@
 //! 59–71; Krack & Gross (2019), §4.5.
 
 use super::{
-    checked_guess, fd_jacobian, forcing_omega, harmonic_amplitudes, newton, Balance, Fourier,
-    HbError, HbOptions, HbOrbit, Layout, ModeNorm,
+    checked_guess, forcing_omega, harmonic_amplitudes, newton, Balance, Fourier, HbError,
+    HbOptions, HbOrbit, Layout, ModeNorm,
 };
 use nalgebra::DMatrix;
 
@@ -126,7 +126,7 @@ pub fn nonlinear_mode<S: crate::model::System<N> + ?Sized, const N: usize>(
     let w = lay.n * lay.width();
     let solved = newton(
         &res,
-        &|x, r| fd_jacobian(&res, x, r),
+        &|x, r| bal.jacobian(x, r),
         &|x| x[w] > 0.0,
         x0,
         opts.newton_tol,
