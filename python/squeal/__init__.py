@@ -894,14 +894,16 @@ def hb(
     constraint by the dynamic Lagrangian step);
     ``multipliers`` as ``{re, im, abs, trivial}`` and ``stable`` from one
     exact period from the HB orbit, whose scaled miss is
-    ``shooting_defect``; ``convergence`` (rows for H/4, H/2, H:
+    ``shooting_defect``; ``hill`` (of a smooth orbit, without mode
+    switches: ``multipliers`` and ``max_multiplier`` by Hill's method from
+    the series alone; ``None`` otherwise); ``convergence`` (rows for H/4, H/2, H:
     ``harmonics``, ``freq_hz``, ``amplitude_change``, ``residual``);
     ``warnings``; ``guess`` (where the first guess came from). ``harmonics``
     is H (1…400); ``guess`` is ``"settle"`` (a settled simulation, as
     ``cycle``) or ``"hopf"`` (steady sliding's growing mode, no simulation,
     settling only if that finds no stable orbit); the settling options are
-    ``cycle``'s. Orbits that stick raise ``ScenarioError``. With ``out``,
-    the CLI's files (``hb_orbit.csv``, ``summary.json``, ``hb.png``) are
+    ``cycle``'s. Orbits that stick are solved with stick as a constraint.
+    With ``out``, the CLI's files (``hb_orbit.csv``, ``summary.json``, ``hb.png``) are
     written there.
 
     With ``param=(NAME, LO, HI, N)`` (``--param``) the solution is followed

@@ -14,6 +14,7 @@ mod equilibrium;
 mod fe_formats;
 mod hb;
 mod hb_forced;
+mod hb_hill;
 mod hb_nma;
 mod hb_stick;
 mod lanczos;

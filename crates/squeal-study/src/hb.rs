@@ -86,6 +86,10 @@ pub struct HbFound {
     pub stability_resolved: bool,
     /// Largest non-trivial modulus.
     pub max_multiplier: f64,
+    /// Of a smooth orbit (no mode switches) on which Newton converged, the
+    /// multipliers `(re, im, trivial)` by Hill's method from the series alone
+    /// (`squeal_core::hb::hill`), and their largest non-trivial modulus.
+    pub hill: Option<HillMultipliers>,
     /// Scaled `|φ_T(z₀) − z₀|` of the exact flow from the HB orbit.
     pub defect: f64,
     /// Events of the exact flow over that period (order of `EventKind::ALL`).
@@ -106,6 +110,15 @@ pub struct HbFound {
     /// (at least 1024), and the exact flow from its state at phase 0
     /// (step ends and events); rows `[t, states…]`.
     pub orbit: Option<(Rows, Rows)>,
+}
+
+/// The multipliers of a smooth orbit by Hill's method.
+#[derive(Debug, Clone)]
+pub struct HillMultipliers {
+    /// `(re, im, trivial)`, by real part of the exponent, largest first.
+    pub multipliers: Vec<(f64, f64, bool)>,
+    /// The largest non-trivial modulus.
+    pub max_multiplier: f64,
 }
 
 /// Check `--harmonics`.
@@ -706,6 +719,34 @@ fn finish<M: System<N> + ?Sized, const N: usize>(
             st.defect
         ));
     }
+    // Hill's method where it is exact in the limit: a smooth, converged orbit.
+    let hill = if o.switches == 0 && !o.sticks && !o.lagrangian && o.converged {
+        match squeal_core::hb::hill::hill(m, &o) {
+            Ok(h) => {
+                if (h.max_multiplier - st.max).abs() > 1e-3 * st.max.max(1.0) {
+                    warnings.push(format!(
+                        "Hill's method gives a largest non-trivial |multiplier| of {:.9}, one exact period {:.9}: the series is truncated (raise --harmonics); the exact period's is the one to trust",
+                        h.max_multiplier, st.max
+                    ));
+                }
+                Some(HillMultipliers {
+                    multipliers: h
+                        .multipliers
+                        .iter()
+                        .enumerate()
+                        .map(|(k, mu)| (mu.re, mu.im, h.trivial == Some(k)))
+                        .collect(),
+                    max_multiplier: h.max_multiplier,
+                })
+            }
+            Err(e) => {
+                warnings.push(format!("no multipliers by Hill's method: {e}"));
+                None
+            }
+        }
+    } else {
+        None
+    };
     Ok(HbFound {
         harmonics,
         period: o.period(),
@@ -734,6 +775,7 @@ fn finish<M: System<N> + ?Sized, const N: usize>(
         stable: st.stable,
         stability_resolved: st.resolved,
         max_multiplier: st.max,
+        hill,
         defect: st.defect,
         events: st.events,
         convergence,
@@ -865,7 +907,9 @@ impl HbFound {
     /// `max_multiplier`, `events_per_period`) plus `freq_hz`, `harmonics`
     /// (per dof: mean, then the amplitude of each harmonic, m),
     /// `harmonic_count`, `contact_modes`, `stick_constraint`, `convergence`,
-    /// `shooting_defect` and `warnings`.
+    /// `shooting_defect`, `hill` (of a smooth orbit, `multipliers` and
+    /// `max_multiplier` by Hill's method; null where the orbit switches
+    /// modes) and `warnings`.
     pub fn to_json(&self) -> Value {
         let mut modes = Map::new();
         for (name, f) in &self.fractions {
@@ -901,6 +945,9 @@ impl HbFound {
             "stability_resolved": self.stability_resolved,
             "multipliers": multipliers_json(&self.multipliers),
             "max_multiplier": self.max_multiplier,
+            "hill": self.hill.as_ref().map_or(Value::Null, |h| {
+                json!({ "multipliers": multipliers_json(&h.multipliers), "max_multiplier": h.max_multiplier })
+            }),
             "events_per_period": events_json(&self.events),
             "shooting_defect": self.defect,
             "contact_modes": modes,

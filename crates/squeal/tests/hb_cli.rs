@@ -18,6 +18,9 @@ fn hoffmann_hb_equals_the_shooting_cycle() {
         serde_json::from_str(&std::fs::read_to_string(d.path().join("h/summary.json")).unwrap())
             .unwrap();
     assert_eq!(summary, hb);
+    // Contact loss: a switch makes the linearisation jump, no Hill's method.
+    assert!(hb["switches_per_period"].as_u64().unwrap() >= 2);
+    assert!(hb["hill"].is_null());
     let csv = std::fs::read_to_string(d.path().join("h/hb_orbit.csv")).unwrap();
     assert_eq!(csv.lines().next().unwrap(), "t,x,y,vx,vy");
     let rows: Vec<Vec<f64>> = csv
@@ -196,6 +199,15 @@ fn the_duffing_response_and_its_curve_through_both_folds() {
     let liouville = (-2.0 / 2.0 / 15.0f64).exp();
     assert!((one["max_multiplier"].as_f64().unwrap() - liouville).abs() < 1e-6);
     assert_eq!(one["stable"], true);
+    // The orbit is smooth: Hill's method from the series alone gives the
+    // exact period's multipliers (measured to 1e-9).
+    let hill = &one["hill"];
+    assert_eq!(hill["multipliers"].as_array().unwrap().len(), 2);
+    let h = hill["max_multiplier"].as_f64().unwrap();
+    assert!(
+        (h - one["max_multiplier"].as_f64().unwrap()).abs() < 1e-7,
+        "{hill}"
+    );
     // Below the resonance the response is unique: HB is the settled run's.
     let x = one["amplitude"]["x"].as_f64().unwrap();
     assert!((4e-3..1e-2).contains(&x), "{x}");

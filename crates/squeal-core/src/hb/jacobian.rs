@@ -15,7 +15,9 @@
 //!
 //! with `A^q = ∂a/∂q`, `A^v = ∂a/∂v` at each quadrature node (central
 //! differences of the field in its piece's modes: `4n` field evaluations a
-//! node, where differencing the whole residual costs `n(2H+1)` residuals).
+//! node, where differencing the whole residual costs `n(2H+1)` residuals),
+//! each `(i, l)` block from the moments `∫ A_il cos kθ`, `∫ A_il sin kθ`
+//! (`k ≤ 2H`) by the product-to-sum identities ([`Moments`]).
 //! Where the modes change at a switching phase `θ_s` the force jumps (a slip
 //! reversal) and the piece ends move with the unknowns: Leibniz's rule adds
 //! `−Δa_i ψ_j(θ_s) ∂θ_s/∂X`, with `Δa` the field's jump across `θ_s` and
@@ -40,19 +42,19 @@ use std::f64::consts::{PI, TAU};
 const SWITCH_MATCH: f64 = 1e-8;
 
 /// One quadrature node: its phase, weight, and the field's derivatives there.
-struct Node {
-    theta: f64,
-    weight: f64,
+pub(super) struct Node {
+    pub(super) theta: f64,
+    pub(super) weight: f64,
     /// `∂a_i/∂q_l`, row-major `n × n`.
-    aq: Vec<f64>,
+    pub(super) aq: Vec<f64>,
     /// `∂a_i/∂v_l + ξ δ_il`, row-major `n × n`.
-    av: Vec<f64>,
+    pub(super) av: Vec<f64>,
     /// The velocities `v_l`.
     v: Vec<f64>,
 }
 
 /// `φ_c(θ)` and `φ_c'(θ)` for `c = 0 … 2H` (`1, cos θ, sin θ, cos 2θ, …`).
-fn basis(theta: f64, h: usize, phi: &mut [f64], dphi: &mut [f64]) {
+pub(super) fn basis(theta: f64, h: usize, phi: &mut [f64], dphi: &mut [f64]) {
     let (s1, c1) = theta.sin_cos();
     let (mut ck, mut sk) = (1.0, 0.0);
     phi[0] = 1.0;
@@ -70,10 +72,111 @@ fn basis(theta: f64, h: usize, phi: &mut [f64], dphi: &mut [f64]) {
 }
 
 /// The test functions `ψ_j` of the Galerkin projection from `φ`.
-fn test_functions(phi: &[f64], psi: &mut [f64]) {
+pub(super) fn test_functions(phi: &[f64], psi: &mut [f64]) {
     psi[0] = 1.0 / TAU;
     for (p, f) in psi.iter_mut().zip(phi).skip(1) {
         *p = f / PI;
+    }
+}
+
+/// `cos kθ`, `sin kθ` for `k = 0 … 2H` at one phase (angle addition).
+pub(super) struct Trig {
+    cos: Vec<f64>,
+    sin: Vec<f64>,
+}
+
+impl Trig {
+    pub(super) fn new(h: usize) -> Self {
+        Trig {
+            cos: vec![0.0; 2 * h + 1],
+            sin: vec![0.0; 2 * h + 1],
+        }
+    }
+
+    pub(super) fn at(&mut self, theta: f64) {
+        let (s1, c1) = theta.sin_cos();
+        self.cos[0] = 1.0;
+        self.sin[0] = 0.0;
+        for k in 1..self.cos.len() {
+            let (c, s) = (self.cos[k - 1], self.sin[k - 1]);
+            self.cos[k] = c * c1 - s * s1;
+            self.sin[k] = s * c1 + c * s1;
+        }
+    }
+}
+
+/// The moments `C_k = ∫ g cos kθ`, `S_k = ∫ g sin kθ` (`k = 0 … 2H`) of a
+/// function `g` on the period, accumulated node by node. From them every
+/// Galerkin product `∫ g φ_j φ_c ψ` of the `(2H+1)²` pairs follows by the
+/// product-to-sum identities, so a block of the Jacobian costs
+/// `O(nodes·H + H²)` rather than `O(nodes·H²)`.
+#[derive(Clone)]
+pub(super) struct Moments {
+    c: Vec<f64>,
+    s: Vec<f64>,
+}
+
+/// Basis index → (is a sine, harmonic): `0 → (cos, 0)`, `2k−1 → (cos, k)`,
+/// `2k → (sin, k)`.
+fn kind(idx: usize) -> (bool, usize) {
+    (idx > 0 && idx.is_multiple_of(2), idx.div_ceil(2))
+}
+
+impl Moments {
+    pub(super) fn new(h: usize) -> Self {
+        Moments {
+            c: vec![0.0; 2 * h + 1],
+            s: vec![0.0; 2 * h + 1],
+        }
+    }
+
+    /// Add `g = value` at the phase of `trig` (`value` carries the weight).
+    pub(super) fn add(&mut self, trig: &Trig, value: f64) {
+        for (m, t) in self.c.iter_mut().zip(&trig.cos) {
+            *m += value * t;
+        }
+        for (m, t) in self.s.iter_mut().zip(&trig.sin) {
+            *m += value * t;
+        }
+    }
+
+    /// `∫ g φ_j φ_c dθ`.
+    fn product(&self, j: usize, c: usize) -> f64 {
+        let ((sj, kj), (sc, kc)) = (kind(j), kind(c));
+        let sum = kj + kc;
+        let d = kj as isize - kc as isize;
+        let cd = self.c[d.unsigned_abs()];
+        let sd = if d >= 0 {
+            self.s[d as usize]
+        } else {
+            -self.s[(-d) as usize]
+        };
+        match (sj, sc) {
+            (false, false) => 0.5 * (cd + self.c[sum]),
+            (false, true) => 0.5 * (self.s[sum] - sd),
+            (true, false) => 0.5 * (self.s[sum] + sd),
+            (true, true) => 0.5 * (cd - self.c[sum]),
+        }
+    }
+
+    /// `∫ g ψ_j φ_c dθ` (`ψ₀ = 1/2π`, `ψ_j = φ_j/π`).
+    pub(super) fn galerkin(&self, j: usize, c: usize) -> f64 {
+        let scale = if j == 0 { 1.0 / TAU } else { 1.0 / PI };
+        scale * self.product(j, c)
+    }
+
+    /// `∫ g ψ_j φ_c' dθ`: `(cos kθ)' = −k sin kθ`, `(sin kθ)' = k cos kθ`.
+    pub(super) fn galerkin_rate(&self, j: usize, c: usize) -> f64 {
+        let (sc, kc) = kind(c);
+        if kc == 0 {
+            return 0.0;
+        }
+        let k = kc as f64;
+        if sc {
+            k * self.galerkin(j, 2 * kc - 1)
+        } else {
+            -k * self.galerkin(j, 2 * kc)
+        }
     }
 }
 
@@ -111,7 +214,14 @@ impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
     }
 
     /// The field's derivatives at phase `theta` in `modes`.
-    fn node(&self, f: &Fourier, theta: f64, weight: f64, modes: &Modes, xi: f64) -> Node {
+    pub(super) fn node(
+        &self,
+        f: &Fourier,
+        theta: f64,
+        weight: f64,
+        modes: &Modes,
+        xi: f64,
+    ) -> Node {
         let (n, h) = (self.lay.n, N / 2);
         let z: [f64; N] = f.state(theta);
         let t = self.time(f.omega, theta);
@@ -148,6 +258,26 @@ impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
             av,
             v: z[h..h + n].to_vec(),
         }
+    }
+
+    /// Every quadrature node of `pieces` with the field's derivatives there
+    /// (in parallel; each node alone, so the result does not depend on the
+    /// thread count).
+    pub(super) fn nodes(&self, f: &Fourier, pieces: &[Piece], xi: f64) -> Vec<Node> {
+        let mut at: Vec<(f64, f64, Modes)> = Vec::with_capacity(4 * pieces.len());
+        for pc in pieces {
+            let (mid, half) = (0.5 * (pc.a + pc.b), 0.5 * (pc.b - pc.a));
+            if half > 0.0 {
+                at.extend(
+                    GAUSS
+                        .iter()
+                        .map(|&(xg, wg)| (mid + half * xg, half * wg, pc.modes)),
+                );
+            }
+        }
+        at.par_iter()
+            .map(|(th, wt, modes)| self.node(f, *th, *wt, modes, xi))
+            .collect()
     }
 
     /// `∂θ_s/∂X` of the switch at `theta` from `ma` to `mb` over the
@@ -208,31 +338,19 @@ impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
             None => 0.0,
         };
         let pieces: Vec<Piece> = self.pieces(&f);
-        let mut at: Vec<(f64, f64, Modes)> = Vec::with_capacity(4 * pieces.len());
-        for pc in &pieces {
-            let (mid, half) = (0.5 * (pc.a + pc.b), 0.5 * (pc.b - pc.a));
-            if half > 0.0 {
-                at.extend(
-                    GAUSS
-                        .iter()
-                        .map(|&(xg, wg)| (mid + half * xg, half * wg, pc.modes)),
-                );
-            }
-        }
-        let nodes: Vec<Node> = at
-            .par_iter()
-            .map(|(th, wt, modes)| self.node(&f, *th, *wt, modes, xi))
-            .collect();
+        let nodes = self.nodes(&f, &pieces, xi);
         // ∂P/∂(c, ω, ξ): rows i·w + j, columns as x's (unscaled).
         let blocks: Vec<Vec<f64>> = (0..n)
             .into_par_iter()
             .map(|i| {
                 let mut blk = vec![0.0; w * m];
-                let (mut phi, mut dphi, mut psi, mut u) =
-                    (vec![0.0; w], vec![0.0; w], vec![0.0; w], vec![0.0; w]);
+                let (mut phi, mut dphi, mut psi) = (vec![0.0; w], vec![0.0; w], vec![0.0; w]);
+                let mut trig = Trig::new(h);
+                // The moments of A^q_il and ω A^v_il, one dof l at a time.
+                let mut mq = vec![Moments::new(h); n];
+                let mut mv = vec![Moments::new(h); n];
                 for nd in &nodes {
-                    basis(nd.theta, h, &mut phi, &mut dphi);
-                    test_functions(&phi, &mut psi);
+                    trig.at(nd.theta);
                     let mut d_omega = 0.0;
                     for l in 0..n {
                         let (aq, av) = (nd.aq[i * n + l], nd.av[i * n + l]);
@@ -240,23 +358,27 @@ impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
                             continue;
                         }
                         d_omega += av * nd.v[l] / omega;
-                        let (a, b) = (nd.weight * aq, nd.weight * av * omega);
-                        for c in 0..w {
-                            u[c] = a * phi[c] + b * dphi[c];
-                        }
+                        mq[l].add(&trig, nd.weight * aq);
+                        mv[l].add(&trig, nd.weight * av * omega);
+                    }
+                    if autonomous || lay.mode.is_some() {
+                        basis(nd.theta, h, &mut phi, &mut dphi);
+                        test_functions(&phi, &mut psi);
                         for (j, pj) in psi.iter().enumerate() {
-                            let row = &mut blk[j * m + l * w..j * m + (l + 1) * w];
-                            for (r, uc) in row.iter_mut().zip(&u) {
-                                *r += pj * uc;
+                            if autonomous {
+                                blk[j * m + n * w] += nd.weight * pj * d_omega;
+                            }
+                            if lay.mode.is_some() {
+                                blk[j * m + n * w + 1] += nd.weight * pj * nd.v[i];
                             }
                         }
                     }
-                    for (j, pj) in psi.iter().enumerate() {
-                        if autonomous {
-                            blk[j * m + n * w] += nd.weight * pj * d_omega;
-                        }
-                        if lay.mode.is_some() {
-                            blk[j * m + n * w + 1] += nd.weight * pj * nd.v[i];
+                }
+                for l in 0..n {
+                    for j in 0..w {
+                        let row = &mut blk[j * m + l * w..j * m + (l + 1) * w];
+                        for (c, r) in row.iter_mut().enumerate() {
+                            *r = mq[l].galerkin(j, c) + mv[l].galerkin_rate(j, c);
                         }
                     }
                 }

@@ -54,6 +54,7 @@
 //! (alternating frequency–time).
 
 pub mod continuation;
+pub mod hill;
 mod jacobian;
 mod lagrangian;
 pub mod nma;
@@ -989,7 +990,13 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
     let left = harmonic_amplitudes(&fourier)
         .into_iter()
         .fold(0.0, f64::max);
-    if left < 1e-6 * top {
+    // Collapsed onto the steady state: relative to the guess, or to the
+    // static state itself (an "orbit" of 1e-9 of the static deflection is
+    // steady sliding whatever the guess; Newton's method may stall near it
+    // rather than converge, and a stalled one below 1e-6 counts too).
+    let mean = fourier.coeffs.iter().fold(0.0f64, |m, c| m.max(c[0].abs()));
+    let floor = if solved.converged { 1e-9 } else { 1e-6 };
+    if left < 1e-6 * top || left < floor * mean {
         return Err(HbError::Collapsed(left / top));
     }
     Ok(bal.orbit(

@@ -196,6 +196,12 @@ fn print_rest(f: &HbFound) {
             if trivial { "  trivial" } else { "" }
         );
     }
+    if let Some(h) = &f.hill {
+        crate::outln!(
+            "Hill's method (smooth orbit, from the series alone): largest non-trivial |multiplier| {:.9}",
+            h.max_multiplier
+        );
+    }
     for w in &f.warnings {
         crate::outln!("warning: {w}");
     }
