@@ -499,11 +499,14 @@ fn solve<M: System<N> + ?Sized, const N: usize>(
                         let z_hb: [f64; N] = o.fourier.state(0.0);
                         let c =
                             cycle::floquet_from(m, &z_hb, o.period(), opts).map_err(cycle_err)?;
-                        let stable = c.stable;
-                        if best.is_none() || stable {
+                        // An orbit not known to be unstable ends the search:
+                        // the settled period's k turns of it would only
+                        // repeat it (with its multipliers' k-th powers).
+                        let done = c.stable || unresolved(&c);
+                        if best.is_none() || c.stable {
                             best = Some((o, conv, amp, notes, c, z_hb));
                         }
-                        if stable {
+                        if done {
                             break;
                         }
                     }

@@ -221,12 +221,12 @@ pub fn hb_branch_from<const N: usize>(
         }
     };
     // ∂R/∂X, m × (m + 1).
-    let jacobian = |xx: &[f64], r: &[f64]| -> DMatrix<f64> {
+    let jacobian = |xx: &[f64], r: &[f64], differences: bool| -> DMatrix<f64> {
         let p = param(xx[m]);
         let mut jx = DMatrix::<f64>::from_element(m, m, f64::NAN);
         let _ = family.visit(p, &mut |sys| {
             if let Ok(bal) = Balance::new(sys, &lay) {
-                jx = bal.jacobian(&xx[..m], &r[..m]);
+                jx = bal.jacobian(&xx[..m], &r[..m], differences);
             }
         });
         let dh = 1e-7 * xx[m].abs().max(1.0);
@@ -244,7 +244,7 @@ pub fn hb_branch_from<const N: usize>(
     let tangent = |xx: &[f64], prev: &DVector<f64>| -> Option<DVector<f64>> {
         let mut r = vec![0.0; m];
         residual(xx, &mut r);
-        let j = jacobian(xx, &r);
+        let j = jacobian(xx, &r, false);
         let mut a = DMatrix::<f64>::zeros(m + 1, m + 1);
         a.view_mut((0, 0), (m, m + 1)).copy_from(&j);
         for c in 0..=m {
@@ -293,9 +293,10 @@ pub fn hb_branch_from<const N: usize>(
                     residual(xs, &mut o[..m]);
                     o[m] = xs[ia] - a;
                 };
-                let fixed_jac = |xs: &[f64], r: &[f64]| {
+                let fixed_jac = |xs: &[f64], r: &[f64], d: bool| {
                     let mut j = DMatrix::<f64>::zeros(m + 1, m + 1);
-                    j.view_mut((0, 0), (m, m + 1)).copy_from(&jacobian(xs, r));
+                    j.view_mut((0, 0), (m, m + 1))
+                        .copy_from(&jacobian(xs, r, d));
                     j[(m, ia)] = 1.0;
                     j
                 };
@@ -371,8 +372,8 @@ pub fn hb_branch_from<const N: usize>(
             residual(xx, o);
             o[m] = (0..=m).map(|i| tc[i] * (xx[i] - xc[i])).sum();
         };
-        let aug_jac = |xx: &[f64], r: &[f64]| {
-            let j = jacobian(xx, r);
+        let aug_jac = |xx: &[f64], r: &[f64], d: bool| {
+            let j = jacobian(xx, r, d);
             let mut a = DMatrix::<f64>::zeros(m + 1, m + 1);
             a.view_mut((0, 0), (m, m + 1)).copy_from(&j);
             for c in 0..=m {
@@ -406,11 +407,11 @@ pub fn hb_branch_from<const N: usize>(
                 full.push(end);
                 residual(&full, o);
             };
-            let fixed_jac = |xs: &[f64], r: &[f64]| {
+            let fixed_jac = |xs: &[f64], r: &[f64], d: bool| {
                 let mut jx = DMatrix::<f64>::from_element(m, m, f64::NAN);
                 let _ = family.visit(param(end), &mut |sys| {
                     if let Ok(bal) = Balance::new(sys, &lay) {
-                        jx = bal.jacobian(xs, r);
+                        jx = bal.jacobian(xs, r, d);
                     }
                 });
                 jx

@@ -183,8 +183,8 @@ impl Moments {
 impl<S: System<N> + ?Sized, const N: usize> Balance<'_, S, N> {
     /// The Jacobian of [`Balance::residual`] at `x` (residual `r`): assembled
     /// (module documentation) where it can be, else by finite differences.
-    pub(crate) fn jacobian(&self, x: &[f64], r: &[f64]) -> DMatrix<f64> {
-        if self.lay.lagrangian.is_none() {
+    pub(crate) fn jacobian(&self, x: &[f64], r: &[f64], differences: bool) -> DMatrix<f64> {
+        if self.lay.lagrangian.is_none() && !differences {
             if let Some(j) = self.assembled(x) {
                 return j;
             }

@@ -773,8 +773,10 @@ pub(crate) fn fd_jacobian(
     DMatrix::from_fn(m, x.len(), |i, j| cols[j][i])
 }
 
-/// The Jacobian at `x` (residual `r`) of a Newton problem.
-pub(crate) type JacobianFn<'a> = dyn Fn(&[f64], &[f64]) -> DMatrix<f64> + 'a;
+/// The Jacobian at `x` (residual `r`) of a Newton problem; with
+/// `differences`, by finite differences of the residual rather than
+/// assembled (see [`newton`]).
+pub(crate) type JacobianFn<'a> = dyn Fn(&[f64], &[f64], bool) -> DMatrix<f64> + 'a;
 
 /// What [`newton`] ended with.
 pub(crate) struct Solved {
@@ -786,8 +788,11 @@ pub(crate) struct Solved {
 }
 
 /// Newton's method on `residual(x) = 0` (as many equations as unknowns)
-/// with the Jacobian `jacobian(x, r)` and a backtracking line search on
-/// the residual's 2-norm; `admissible` rejects trial points (ω ≤ 0, say).
+/// with the Jacobian `jacobian(x, r, differences)` and a backtracking line
+/// search on the residual's 2-norm; `admissible` rejects trial points
+/// (ω ≤ 0, say). The Jacobian is the assembled one until Newton's method
+/// slows down and it disagrees with the residual's derivative along the
+/// step, then by differences.
 /// `what` names the problem in errors.
 pub(crate) fn newton(
     residual: &dyn Fn(&[f64], &mut [f64]),
@@ -805,6 +810,7 @@ pub(crate) fn newton(
     let mut iterations = 0;
     let mut stalled = false;
     let mut approximate = false;
+    let mut differences = false;
     let mut last = f64::INFINITY;
     loop {
         let res = max_abs(&r);
@@ -826,14 +832,47 @@ pub(crate) fn newton(
             )));
         }
         iterations += 1;
+        let slow = res > 0.5 * last;
         last = res;
-        let jac = jacobian(&x, &r);
         let rhs = DVector::from_iterator(m, r.iter().map(|v| -v));
-        let dx = jac.lu().solve(&rhs).ok_or_else(|| {
-            HbError::NotConverged(format!(
-                "the Jacobian is singular at iteration {iterations} ({what})"
-            ))
-        })?;
+        let solve = |jac: DMatrix<f64>| {
+            jac.lu().solve(&rhs).ok_or_else(|| {
+                HbError::NotConverged(format!(
+                    "the Jacobian is singular at iteration {iterations} ({what})"
+                ))
+            })
+        };
+        let jac = jacobian(&x, &r, differences);
+        let mut dx = solve(jac.clone())?;
+        // An assembled Jacobian is exact only where each switch's phase
+        // moves smoothly with the unknowns; where Newton's method slows
+        // down (the last step did not halve the residual), the Jacobian
+        // is checked against the residual's own derivative along the step
+        // (central differences) and, if it is off by more than 1e-2,
+        // replaced by differences for the rest of the solve.
+        if slow && !differences {
+            let h = 1e-7 * norm2(&x).max(1.0) / dx.norm().max(f64::MIN_POSITIVE);
+            let at = |s: f64| {
+                let xs: Vec<f64> = x.iter().zip(dx.iter()).map(|(a, d)| a + s * d).collect();
+                let mut rs = vec![0.0; m];
+                residual(&xs, &mut rs);
+                rs
+            };
+            let (rp, rm) = (at(h), at(-h));
+            let predicted = &jac * &dx;
+            let off = rp
+                .iter()
+                .zip(&rm)
+                .zip(predicted.iter())
+                .map(|((a, b), p)| ((a - b) / (2.0 * h) - p).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let agrees = off <= 1e-2 * predicted.norm(); // false if NaN
+            if !agrees {
+                differences = true;
+                dx = solve(jacobian(&x, &r, true))?;
+            }
+        }
         // Backtracking on the residual's 2-norm.
         let r0 = norm2(&r);
         let mut lambda = 1.0;
@@ -979,7 +1018,7 @@ pub fn harmonic_balance<S: System<N> + ?Sized, const N: usize>(
     let res = |x: &[f64], out: &mut [f64]| bal.residual(x, out);
     let solved = newton(
         &res,
-        &|x, r| bal.jacobian(x, r),
+        &|x, r, d| bal.jacobian(x, r, d),
         &|x| x[m - 1] > 0.0,
         lay.to_x(&guess),
         opts.newton_tol,
@@ -1056,7 +1095,7 @@ pub fn forced_response<S: System<N> + ?Sized, const N: usize>(
     let res = |x: &[f64], out: &mut [f64]| bal.residual(x, out);
     let solved = newton(
         &res,
-        &|x, r| bal.jacobian(x, r),
+        &|x, r, d| bal.jacobian(x, r, d),
         &|_| true,
         lay.to_x(&guess),
         opts.newton_tol,

@@ -126,7 +126,7 @@ pub fn nonlinear_mode<S: crate::model::System<N> + ?Sized, const N: usize>(
     let w = lay.n * lay.width();
     let solved = newton(
         &res,
-        &|x, r| bal.jacobian(x, r),
+        &|x, r, d| bal.jacobian(x, r, d),
         &|x| x[w] > 0.0,
         x0,
         opts.newton_tol,
