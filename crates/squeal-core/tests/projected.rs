@@ -409,3 +409,57 @@ fn dense_real_modes_are_accurate() {
         }
     }
 }
+
+/// The analysis and its truncation table computed together (one Lanczos
+/// solve and one set of static responses) equal the two computed apart,
+/// on the sparse path and for both bases.
+#[test]
+fn analysis_with_its_table_equals_the_two_apart() {
+    use squeal_core::stability::projected::{
+        analyse_projected_with_table, truncation_table, BasisKind,
+    };
+    let mut l = embedded(300, true);
+    l.modal.dense_max_dofs = 0;
+    l.modal.cutoff_hz = 30_000.0;
+    let z = l.equilibrium_dyn().unwrap();
+    let names = l.state_names();
+    for (sys_sparse, kind) in [(true, BasisKind::Modes), (false, BasisKind::CraigBampton)] {
+        let basis = l.modal.basis();
+        let (an, table) = if sys_sparse {
+            let sys = l.second_order_sparse(&z);
+            let (an, t) = analyse_projected_with_table(&sys, &z, names, None, basis, kind).unwrap();
+            let apart = analyse_projected(&sys, &z, names, None, basis, kind).unwrap();
+            (
+                vec![an, apart],
+                vec![t.unwrap(), truncation_table(&sys, basis, kind).unwrap()],
+            )
+        } else {
+            let sys = l.second_order_dyn(&z);
+            let (an, t) = analyse_projected_with_table(&sys, &z, names, None, basis, kind).unwrap();
+            let apart = analyse_projected(&sys, &z, names, None, basis, kind).unwrap();
+            (
+                vec![an, apart],
+                vec![t.unwrap(), truncation_table(&sys, basis, kind).unwrap()],
+            )
+        };
+        assert_eq!(an[0].eigen.len(), an[1].eigen.len());
+        assert!(an[0].eigen.len() > 40, "{} modes", an[0].eigen.len());
+        for (a, b) in an[0].eigen.iter().zip(&an[1].eigen) {
+            let d = (a.re - b.re).hypot(a.im - b.im);
+            assert!(d <= 1e-12 * a.re.hypot(a.im), "{kind:?}: {a:?} vs {b:?}");
+        }
+        assert_eq!(table[0].len(), table[1].len());
+        assert!(table[0].len() >= 3, "{} rows", table[0].len());
+        for (a, b) in table[0].iter().zip(&table[1]) {
+            assert_eq!((a.modes, a.static_vectors), (b.modes, b.static_vectors));
+            assert_eq!(a.eigenvalues.len(), b.eigenvalues.len());
+            for (x, y) in a.eigenvalues.iter().zip(&b.eigenvalues) {
+                assert!(
+                    (x - y).norm() <= 1e-12 * x.norm(),
+                    "{kind:?} row {}: {x} vs {y}",
+                    a.modes
+                );
+            }
+        }
+    }
+}

@@ -308,10 +308,36 @@ pub fn convergence(model: &AnyModel, an: &Analysis) -> Option<Result<Convergence
         return None;
     }
     // At the analysis's own steady sliding (not found again).
-    let rows = match squeal_core::stability::lumped::truncation_table_at(l, &an.equilibrium) {
-        Ok(r) => r,
-        Err(e) => return Some(Err(e)),
-    };
+    Some(
+        squeal_core::stability::lumped::truncation_table_at(l, &an.equilibrium)
+            .map(|rows| convergence_of(rows, an)),
+    )
+}
+
+/// The analysis of `model` ([`analyse`]) with its [`convergence`], the
+/// modes and static responses computed once for both (a model analysed by
+/// projection; others as [`analyse`], with `None`).
+#[allow(clippy::type_complexity)]
+pub fn analyse_with_convergence(
+    model: &AnyModel,
+) -> Result<(Analysis, Option<Result<Convergence, StabilityError>>), StabilityError> {
+    match model {
+        AnyModel::Lumped(l) if l.modal.projects(l.dof_count()) => {
+            let (an, table) =
+                squeal_core::stability::lumped::analyse_with_table(l, Some(&l.diagonal_masses()))?;
+            let conv = table.map(|t| t.map(|rows| convergence_of(rows, &an)));
+            Ok((an, conv))
+        }
+        _ => Ok((analyse(model)?, None)),
+    }
+}
+
+/// The [`Convergence`] of the truncation-table `rows`, following the
+/// eigenvalues of `an`.
+fn convergence_of(
+    rows: Vec<squeal_core::stability::projected::Truncation>,
+    an: &Analysis,
+) -> Convergence {
     let mut tracked: Vec<nalgebra::Complex<f64>> = an
         .eigen
         .iter()
@@ -350,13 +376,13 @@ pub fn convergence(model: &AnyModel, an: &Analysis) -> Option<Result<Convergence
     let signs_kept = k < 2
         || (0..tracked.len()).all(|j| (matched[k - 1][j].re > 0.0) == (matched[k - 2][j].re > 0.0));
     let settled = signs_kept && change.iter().all(|c| *c <= SETTLED);
-    Some(Ok(Convergence {
+    Convergence {
         rows,
         tracked,
         matched,
         change,
         settled,
-    }))
+    }
 }
 
 impl Convergence {

@@ -107,6 +107,35 @@ pub fn truncation_table_at(
     }
 }
 
+/// [`analyse`] with, for a model analysed by projection, its truncation
+/// table ([`projected::analyse_projected_with_table`]: the modes and static
+/// responses computed once for both); `None` for a model solved dense.
+#[allow(clippy::type_complexity)]
+pub fn analyse_with_table(
+    l: &Lumped,
+    masses: Option<&[f64]>,
+) -> Result<
+    (
+        Analysis,
+        Option<Result<Vec<projected::Truncation>, StabilityError>>,
+    ),
+    StabilityError,
+> {
+    if !l.modal.projects(l.dof_count()) {
+        return Ok((analyse(l, masses)?, None));
+    }
+    let z = equilibrium(l)?;
+    let (basis, kind) = (l.modal.basis(), l.modal.kind);
+    let (an, table) = if sparse(l) {
+        let sys = l.second_order_sparse(&z);
+        projected::analyse_projected_with_table(&sys, &z, l.state_names(), masses, basis, kind)?
+    } else {
+        let sys = l.second_order_dyn(&z);
+        projected::analyse_projected_with_table(&sys, &z, l.state_names(), masses, basis, kind)?
+    };
+    Ok((an, Some(table)))
+}
+
 /// Full complex eigenvalue analysis of a lumped model of any size (every
 /// mode with its eigenvector, energy shares and dominant coordinate): dense
 /// by [`super::modal::analyse_matrix`] up to `l.modal.dense_max_dofs` dofs,

@@ -693,13 +693,32 @@ pub fn truncation_table<S: Structure + ?Sized>(
         return craig_bampton_truncation(&sys.dense(), basis);
     }
     let full = sys.undamped(basis)?;
-    let m = full.phi.ncols();
+    let responses = correction_responses(sys, &full)?;
+    table_rows(sys, &full, &responses)
+}
+
+/// The static responses [`with_static_correction`] adds to `modes`: at the
+/// coupling dofs, none when there are none or the modes span the space.
+fn correction_responses<S: Structure + ?Sized>(
+    sys: &S,
+    modes: &UndampedBasis,
+) -> Result<faer::Mat<f64>, StabilityError> {
     let dofs = sys.coupling_dofs();
-    let responses = if dofs.is_empty() || m >= sys.dofs() {
-        faer::Mat::<f64>::zeros(sys.dofs(), 0)
+    if dofs.is_empty() || modes.phi.ncols() >= sys.dofs() {
+        Ok(faer::Mat::<f64>::zeros(sys.dofs(), 0))
     } else {
-        static_responses(sys, &dofs)?
-    };
+        static_responses(sys, &dofs)
+    }
+}
+
+/// The rows of [`truncation_table`] from the undamped modes `full` and the
+/// static responses that correct each row's basis.
+fn table_rows<S: Structure + ?Sized>(
+    sys: &S,
+    full: &UndampedBasis,
+    responses: &faer::Mat<f64>,
+) -> Result<Vec<Truncation>, StabilityError> {
+    let m = full.phi.ncols();
     let mut counts: Vec<usize> = [1usize, 2, 3, 4]
         .iter()
         .map(|q| (m * q).div_ceil(4).max(1))
@@ -714,7 +733,7 @@ pub fn truncation_table<S: Structure + ?Sized>(
                 static_vectors: 0,
                 sturm_count: None,
             };
-            let b = augment(sys, b, &responses)?;
+            let b = augment(sys, b, responses)?;
             let a = reduced_state_matrix(sys, &b);
             Ok(Truncation {
                 modes: k,
@@ -804,6 +823,19 @@ pub fn analyse_projected<S: Structure + ?Sized>(
     basis: Basis,
     kind: BasisKind,
 ) -> Result<Analysis, StabilityError> {
+    let n = checked(sys, z, state_names, masses)?;
+    let b = basis_of(sys, basis, kind)?;
+    analyse_in(sys, n, z, state_names, masses, &b, kind)
+}
+
+/// The dof count of `sys` once `z`, `state_names` and `masses` are checked
+/// against it.
+fn checked<S: Structure + ?Sized>(
+    sys: &S,
+    z: &[f64],
+    state_names: &[String],
+    masses: Option<&[f64]>,
+) -> Result<usize, StabilityError> {
     let n = sys.validate()?;
     if z.len() != 2 * n || state_names.len() != 2 * n {
         return Err(StabilityError::BadInput(format!(
@@ -819,8 +851,46 @@ pub fn analyse_projected<S: Structure + ?Sized>(
             )));
         }
     }
-    let b = basis_of(sys, basis, kind)?;
-    let a = reduced_state_matrix(sys, &b);
+    Ok(n)
+}
+
+/// [`analyse_projected`] and [`truncation_table`] together: the undamped
+/// modes and the static responses, the costly part of both (a Lanczos
+/// solve and a factorisation of `K_s + sM` on a sparse model), computed
+/// once. The table's error is its own: the analysis stands without it.
+#[allow(clippy::type_complexity)]
+pub fn analyse_projected_with_table<S: Structure + ?Sized>(
+    sys: &S,
+    z: &[f64],
+    state_names: &[String],
+    masses: Option<&[f64]>,
+    basis: Basis,
+    kind: BasisKind,
+) -> Result<(Analysis, Result<Vec<Truncation>, StabilityError>), StabilityError> {
+    if kind == BasisKind::CraigBampton {
+        let an = analyse_projected(sys, z, state_names, masses, basis, kind)?;
+        return Ok((an, truncation_table(sys, basis, kind)));
+    }
+    let n = checked(sys, z, state_names, masses)?;
+    let full = sys.undamped(basis)?;
+    let responses = correction_responses(sys, &full)?;
+    let table = table_rows(sys, &full, &responses);
+    let b = augment(sys, full, &responses)?;
+    Ok((analyse_in(sys, n, z, state_names, masses, &b, kind)?, table))
+}
+
+/// [`analyse_projected`] of the checked `n`-dof `sys` in the basis `b`
+/// (built for `kind`).
+fn analyse_in<S: Structure + ?Sized>(
+    sys: &S,
+    n: usize,
+    z: &[f64],
+    state_names: &[String],
+    masses: Option<&[f64]>,
+    b: &UndampedBasis,
+    kind: BasisKind,
+) -> Result<Analysis, StabilityError> {
+    let a = reduced_state_matrix(sys, b);
     let mut pairs = eigenpairs(&a)?;
     // In the order of the analysis (growth rate descending, +ω first), so
     // that the budget keeps the vectors that matter.
@@ -854,6 +924,6 @@ pub fn analyse_projected<S: Structure + ?Sized>(
         }
     }
     let mut an = finish(modes, z.to_vec());
-    an.method = method(sys, &b, kind);
+    an.method = method(sys, b, kind);
     Ok(an)
 }

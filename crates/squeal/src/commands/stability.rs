@@ -10,7 +10,7 @@ use crate::ScenarioArgs;
 use clap::Args;
 use squeal_core::stability::Analysis;
 use squeal_study::levers::{lever_keys, Levers};
-use squeal_study::stability::{analyse, document};
+use squeal_study::stability::document;
 
 /// Arguments of `squeal stability`.
 #[derive(Args, Debug)]
@@ -76,8 +76,10 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
     if let Some(p) = squeal_study::plan::plan(&sc, "stability", 1) {
         crate::errln!("{p}");
     }
-    let an =
-        analyse(&sc.model).map_err(|e| squeal_study::feasible::stability_failure(&sc.model, e))?;
+    // The analysis with the truncation error of a projected one (issue 27
+    // §2), its modes computed once for both.
+    let (an, convergence) = squeal_study::stability::analyse_with_convergence(&sc.model)
+        .map_err(|e| squeal_study::feasible::stability_failure(&sc.model, e))?;
     if let Some(dest) = &a.out {
         let stage = crate::run::Staging::new_as("--out", dest)?;
         squeal_files::modes::write_modes_csv(&stage.path("modes.csv"), &sc.model, &an)?;
@@ -89,8 +91,7 @@ pub fn run(a: StabilityArgs) -> Result<(), RunError> {
         let bar = crate::run::progress_bar(lever_keys(&sc.model).len() as u64, "searching levers");
         squeal_study::levers::search(&sc.model, &bar, &crate::run::NEVER)?
     };
-    // The truncation error of a projected analysis (issue 27 §2).
-    let convergence = match squeal_study::stability::convergence(&sc.model, &an) {
+    let convergence = match convergence {
         Some(Ok(c)) => Some(c),
         Some(Err(e)) => {
             crate::errln!("warning: no truncation table: {e}");
