@@ -327,6 +327,11 @@ fn with_stick<const N: usize>(
     let steps2 = (rest.ceil() as usize + 1).max(2);
     let mut b2 = *bopts;
     b2.hb.lagrangian = true;
+    // The slip and stick-slip branches meet at a corner: the start's
+    // tangent is the slip branch's, so the leg starts with a small step
+    // (then grows it by half at each easy step) rather than jumping along
+    // that tangent past the first part of the stick-slip branch.
+    b2.first_step = 0.05 * bopts.max_step;
     // The last orbit solved again with stick as a constraint: the start.
     let mut solved = None;
     family

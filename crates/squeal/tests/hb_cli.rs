@@ -471,6 +471,12 @@ fn hb_param_starts_at_the_hopf_point_when_lo_has_no_orbit() {
     };
     let (s, v) = speed(slip - 1);
     assert!((s - v).abs() <= 2e-3 * v, "{s} vs {v}");
+    // The stick-slip leg starts with a small step from the corner where
+    // the two branches meet: no gap there (it was 2.5 grid spacings when
+    // the leg's first step followed the slip branch's tangent at full
+    // length).
+    let gap = at(slip).0 - at(slip - 1).0;
+    assert!(gap > 0.0 && gap < 0.25 * 0.01, "first stick step {gap}");
     assert!(br["end"].as_str().unwrap().starts_with("reached"), "{br}");
     assert!(pts[slip..].iter().all(|p| p["stick_constraint"] == true));
     let (s, v) = speed(pts.len() - 1);

@@ -47,6 +47,10 @@ pub struct HbBranchOptions {
     pub min_step: f64,
     /// Largest step (grid spacings, scaled metric).
     pub max_step: f64,
+    /// The first step (grid spacings, scaled metric; at most `max_step`):
+    /// small where the branch starts at a corner (the start of stick),
+    /// where the tangent of the branch left behind points the wrong way.
+    pub first_step: f64,
 }
 
 impl Default for HbBranchOptions {
@@ -56,6 +60,7 @@ impl Default for HbBranchOptions {
             max_points: 2000,
             min_step: 1e-4,
             max_step: 1.0,
+            first_step: 1.0,
         }
     }
 }
@@ -362,7 +367,7 @@ pub fn hb_branch_from<const N: usize>(
     };
     let mut s_hist = vec![0.0f64];
     let mut sig_dp = if t[m].abs() > DP_ROUNDOFF { t[m] } else { 0.0 };
-    let mut ds = opts.max_step;
+    let mut ds = opts.first_step.min(opts.max_step);
     let tol = opts.hb.newton_tol;
     while out.points.len() < opts.max_points {
         let pred: Vec<f64> = x.iter().zip(t.iter()).map(|(a, b)| a + ds * b).collect();
