@@ -19,7 +19,9 @@ fn belt(m: f64, k: f64, n: f64, v: f64, c: f64, law: FrictionLaw) -> Belt {
     b
 }
 
-fn tight(pos: f64, vel: f64) -> CycleOptions {
+/// Tight shooting options: `rtol` 1e-12, the given absolute tolerances on
+/// positions and velocities, Newton to 1e-11.
+pub(crate) fn tight(pos: f64, vel: f64) -> CycleOptions {
     CycleOptions {
         solver: SolverOptions {
             rtol: 1e-12,

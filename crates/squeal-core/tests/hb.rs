@@ -105,16 +105,7 @@ fn disc_pad_reversal_cycle_by_harmonic_balance() {
 #[test]
 fn van_der_pol_converges_exponentially_in_the_harmonics() {
     let model = crate::cycle::VanDerPol(1.0);
-    let opts = CycleOptions {
-        solver: squeal_core::SolverOptions {
-            rtol: 1e-12,
-            atol_pos: Some(1e-12),
-            atol_vel: Some(1e-12),
-            ..Default::default()
-        },
-        newton_tol: 1e-11,
-        ..CycleOptions::default()
-    };
+    let opts = crate::cycle::tight(1e-12, 1e-12);
     let cyc = find_cycle(&model, 0.0, [0.5, 0.0], &opts).unwrap();
     assert!((cyc.period - 6.663_286_859).abs() < 1e-8, "{}", cyc.period);
     let r = hb_vs_shooting(&model, &cyc, &[3, 6, 12, 24]);

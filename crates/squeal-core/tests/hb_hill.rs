@@ -12,19 +12,6 @@ use squeal_core::model::lumped::Fixed;
 use squeal_core::System;
 use std::f64::consts::TAU;
 
-fn tight() -> CycleOptions {
-    CycleOptions {
-        solver: squeal_core::SolverOptions {
-            rtol: 1e-12,
-            atol_pos: Some(1e-12),
-            atol_vel: Some(1e-12),
-            ..Default::default()
-        },
-        newton_tol: 1e-11,
-        ..CycleOptions::default()
-    }
-}
-
 fn harmonics(h: usize) -> HbOptions {
     HbOptions {
         harmonics: h,
@@ -41,10 +28,10 @@ fn harmonics(h: usize) -> HbOptions {
 #[test]
 fn hill_gives_van_der_pols_floquet_exponent() {
     let model = crate::cycle::VanDerPol(1.0);
-    let cyc = find_cycle(&model, 0.0, [0.5, 0.0], &tight()).unwrap();
+    let cyc = find_cycle(&model, 0.0, [0.5, 0.0], &crate::cycle::tight(1e-12, 1e-12)).unwrap();
     let mu = cyc.multipliers.iter().find(|m| !m.trivial).unwrap();
     let exact = mu.abs().ln() / cyc.period;
-    let o = cycle::orbit(&model, &cyc, &tight()).unwrap();
+    let o = cycle::orbit(&model, &cyc, &crate::cycle::tight(1e-12, 1e-12)).unwrap();
     let fine = Fourier::from_orbit(&o, cyc.period, 1, 40);
     let fine = harmonic_balance(&model, &fine, &harmonics(40))
         .unwrap()
@@ -105,7 +92,8 @@ fn hill_gives_the_forced_duffing_oscillators_multipliers() {
     let found = hill(&sys, &orbit).unwrap();
     assert!(found.trivial.is_none());
     let z0: [f64; 2] = orbit.fourier.state(0.0);
-    let (exact, defect, _) = forced_floquet(&sys, &z0, 1.0 / hz, &tight()).unwrap();
+    let (exact, defect, _) =
+        forced_floquet(&sys, &z0, 1.0 / hz, &crate::cycle::tight(1e-12, 1e-12)).unwrap();
     assert!(defect < 1e-8, "{defect}");
     assert_eq!(exact.len(), 2);
     // Each Hill multiplier next to one of the monodromy's.
