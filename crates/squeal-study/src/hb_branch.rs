@@ -132,9 +132,13 @@ pub fn follow(
         },
     };
     cancel.check()?;
+    // An orbit at `lo` that sticks was solved with stick as a constraint: it
+    // is not a solution of the balance with friction as slip, so the whole
+    // branch goes on that way.
     let bopts = HbBranchOptions {
         hb: HbOptions {
             harmonics,
+            lagrangian: start.as_ref().is_some_and(|s| s.stick_constraint),
             ..HbOptions::default()
         },
         ..HbBranchOptions::default()

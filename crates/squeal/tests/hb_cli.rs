@@ -415,6 +415,45 @@ fn the_friction_dampers_nonlinear_mode() {
 /// form), the orbit has the critical mode's frequency, and the branch of
 /// pure slip ends where its velocity amplitude reaches the belt speed; it
 /// goes on with stick as a constraint.
+/// The thesis law's belt sticks at every speed of the range: the first
+/// orbit (`squeal hb` at `lo`) is solved with stick as a constraint, so the
+/// whole branch is too (a start with stick is not a solution of the
+/// balance with friction as slip, which refused it before). Each end
+/// against `squeal cycle` at that speed.
+#[test]
+fn hb_param_goes_on_with_stick_from_a_start_that_sticks() {
+    let d = tempfile::tempdir().unwrap();
+    let br = json_of(&squeal(
+        d.path(),
+        &["hb", "belt", "--param", "V=0.01:0.1:4", "--json"],
+    ));
+    assert_eq!(br["start"]["stick_constraint"], true, "{br}");
+    let pts = br["points"].as_array().unwrap();
+    assert!(pts.len() >= 4, "{br}");
+    assert!(pts.iter().all(|p| p["stick_constraint"] == true), "{br}");
+    assert!(pts.iter().all(|p| p["stable"] == true), "{br}");
+    for k in [0, pts.len() - 1] {
+        let v = pts[k]["value"].as_f64().unwrap();
+        let set = format!("V={v}");
+        let cy = json_of(&squeal(
+            d.path(),
+            &["cycle", "belt", "--set", &set, "--json"],
+        ));
+        let (fh, fc) = (
+            pts[k]["freq_hz"].as_f64().unwrap(),
+            cy["frequency_hz"].as_f64().unwrap(),
+        );
+        // H = 20 with stick: algebraic convergence (1.4e-4 measured).
+        assert!((fh / fc - 1.0).abs() <= 3e-4, "V = {v}: {fh} vs {fc}");
+        let (a, b) = (
+            pts[k]["amplitude"]["x"].as_f64().unwrap(),
+            cy["amplitude"]["x"].as_f64().unwrap(),
+        );
+        // 2.1e-3 measured.
+        assert!((a / b - 1.0).abs() <= 5e-3, "V = {v}: {a} vs {b}");
+    }
+}
+
 #[test]
 fn hb_param_starts_at_the_hopf_point_when_lo_has_no_orbit() {
     let d = tempfile::tempdir().unwrap();
