@@ -982,11 +982,14 @@ def nma(
     frequency in Hz), and per log-spaced mass-normalised modal amplitude
     (``modal_amplitude=(LO, HI, N)``, m·√kg) the ``points``:
     ``freq_hz`` (Hz), ``damping_ratio``, ``xi`` (the artificial damping,
-    1/s), ``amplitude`` per state, ``residual``, ``sticks``; ``failures``
+    1/s), ``amplitude`` per state, ``residual``, ``sticks``,
+    ``stick_constraint`` (true where the orbit sticks and stick was held as
+    a constraint); ``failures``
     and ``warnings``. Lumped and matrix models only (the mass matrix). With
     ``out``, the CLI's files (``nma.csv``, ``summary.json``, ``nma.png``).
     Besides the document, ``table`` (float64, one row per point, as
-    ``nma.csv`` without ``sticks``) with its ``table_columns``."""
+    ``nma.csv`` without ``sticks`` and ``stick_constraint``) with its
+    ``table_columns``."""
     lo, hi, n = modal_amplitude
     doc: Dict[str, Any] = dict(
         json.loads(

@@ -2,8 +2,11 @@
 //! results: the Duffing oscillator with mass-proportional damping, whose
 //! EPMC orbit is the free conservative one (frequency on the exact elliptic
 //! backbone, `ξ` the damping itself), and the Coulomb-damped oscillator,
-//! whose `ξ` balances the friction's work per period exactly.
+//! whose `ξ` balances the friction's work per period exactly; and a
+//! friction damper that sticks, with stick as a constraint, against the
+//! shooting orbit of the model with the EPMC's negative damping.
 
+use squeal_core::cycle;
 use squeal_core::hb::nma::{mode_guess, nonlinear_mode};
 use squeal_core::hb::{Fourier, HbOptions};
 use squeal_core::model::lumped::Fixed;
@@ -120,4 +123,141 @@ fn a_coulomb_damped_mode_balances_the_friction_work() {
     )
     .unwrap();
     assert!(p.damping_ratio() > 0.0 && big.damping_ratio() < 0.5 * p.damping_ratio());
+}
+
+/// The two-dof chain of NLvib's example with an exact Coulomb damper on x2
+/// (`μN = 10 N` to ground, `k₁ = k₂ = 10⁴ N/m`, `c₁ = c₂ = 0.2 kg/s`, unit
+/// masses), plus an optional damping matrix `C = −ξ I`: with it, the EPMC
+/// orbit of modal amplitude `A` is a periodic orbit of the model itself.
+fn damper_chain(minus_xi: Option<f64>) -> Lumped {
+    use squeal_core::model::lumped::{ContactSpec, LumpedSpec, SpringSpec, Triplets};
+    use squeal_core::FrictionLaw;
+    let on = |v: &[(&str, f64)]| v.iter().map(|(d, c)| (d.to_string(), *c)).collect();
+    let spring = |name: &str, o: Vec<(String, f64)>| SpringSpec {
+        name: name.into(),
+        on: o,
+        k: 1.0e4,
+        c: 0.2,
+        k3: 0.0,
+    };
+    let spec = LumpedSpec {
+        dofs: vec!["x1".into(), "x2".into()],
+        masses: vec![("x1".into(), 1.0), ("x2".into(), 1.0)],
+        c: minus_xi.map(|xi| Triplets {
+            rows: 2,
+            cols: 2,
+            entries: vec![(0, 0, -xi), (1, 1, -xi)],
+        }),
+        springs: vec![
+            spring("k1", on(&[("x1", 1.0)])),
+            spring("k2", on(&[("x2", 1.0), ("x1", -1.0)])),
+        ],
+        contacts: vec![ContactSpec {
+            name: "damper".into(),
+            normal: None,
+            k: None,
+            c: None,
+            bilateral: false,
+            normal_force: Some(10.0),
+            tangent: Some(on(&[("x2", 1.0)])),
+            v: 0.0,
+            friction: FrictionLaw::Coulomb {
+                mu_s: 1.0,
+                mu_k: 1.0,
+            },
+            alpha: 0.0,
+            slope: Vec::new(),
+        }],
+        ..LumpedSpec::default()
+    };
+    Lumped::build(&spec).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn a_mode_whose_damper_sticks_is_the_exact_orbit_with_stick_as_a_constraint() {
+    // Mode 1 stuck: x1 alone on k₁ + k₂, ω = √(2·10⁴). At A = 1.2e-3 the
+    // damper sticks twice per period. The HB orbit with stick as a
+    // constraint, put into the model with C = −ξ I, is a stable periodic
+    // orbit of that model (a friction damper under negative damping), which
+    // shooting finds exactly (event-driven flow, stick exact): HB's
+    // frequency and x1 amplitude approach it as H grows.
+    let l = damper_chain(None);
+    let sys = Fixed::<4>(&l);
+    let mass = nalgebra::DMatrix::<f64>::identity(2, 2);
+    let phi = [1.0, 0.0];
+    let w = 2.0e4f64.sqrt();
+    let stick = |h: usize| HbOptions {
+        lagrangian: true,
+        ..opts(h)
+    };
+    // At A = 1e-3 the damper never slips: the stuck linear mode exactly.
+    let g = mode_guess(&[0.0, 0.0], &phi, w, 1e-3);
+    let stuck = nonlinear_mode(&sys, &mass, &phi, 1e-3, (&g, 0.4), &stick(20)).unwrap();
+    assert!((stuck.orbit.fourier.omega / w - 1.0).abs() < 1e-9);
+    assert!((stuck.xi / 0.4 - 1.0).abs() < 1e-9, "ξ = {}", stuck.xi);
+    let a = 1.2e-3;
+    let mut from = stuck.orbit.fourier.clone();
+    for c in &mut from.coeffs {
+        for v in c.iter_mut() {
+            *v *= a / 1e-3;
+        }
+    }
+    // (relative frequency error, relative x1 amplitude error) against
+    // shooting on the model with C = −ξ_H I.
+    let error = |p: &squeal_core::hb::nma::ModePoint| {
+        let f = &p.orbit.fourier;
+        let aug = damper_chain(Some(p.xi));
+        // At phase π x1 is at its least and ẋ1 crosses zero upwards.
+        let z: [f64; 4] = f.state(PI);
+        let section = cycle::Section {
+            index: 2,
+            level: z[2],
+        };
+        let c = cycle::shoot(
+            &Fixed::<4>(&aug),
+            z,
+            TAU / f.omega,
+            section,
+            &crate::cycle::tight(1e-12, 1e-12),
+        )
+        .unwrap();
+        assert!(c.stable && c.max_multiplier < 0.5, "{}", c.max_multiplier);
+        assert_eq!(c.events_per_period[..2], [2, 2], "two sticks, two slips");
+        // x1's half peak-to-peak from the series.
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for j in 0..20_000 {
+            let z: [f64; 4] = f.state(TAU * j as f64 / 20_000.0);
+            (lo, hi) = (lo.min(z[0]), hi.max(z[0]));
+        }
+        (
+            (f.omega * c.period / TAU - 1.0).abs(),
+            (0.5 * (hi - lo) / c.amplitude[0] - 1.0).abs(),
+        )
+    };
+    let p20 = nonlinear_mode(&sys, &mass, &phi, a, (&from, 0.4), &stick(20)).unwrap();
+    assert!(p20.orbit.sticks && p20.orbit.lagrangian);
+    let p80 = nonlinear_mode(
+        &sys,
+        &mass,
+        &phi,
+        a,
+        (&p20.orbit.fourier, p20.xi),
+        &stick(80),
+    )
+    .unwrap();
+    let (e20, e80) = (error(&p20), error(&p80));
+    // Measured: frequency 1.25e-4 → 4.7e-5, amplitude 1.8e-3 → 1.1e-3
+    // (algebraic: the kinks at stick; not monotone in H, H = 40 is 1.2e-4
+    // and 2.5e-3).
+    assert!(
+        e20.0 < 2e-4 && e80.0 < 7e-5 && e80.0 < 0.5 * e20.0,
+        "{e20:?} {e80:?}"
+    );
+    assert!(
+        e20.1 < 3e-3 && e80.1 < 1.5e-3 && e80.1 < e20.1,
+        "{e20:?} {e80:?}"
+    );
+    // Stick-slip damps the mode far more than the stuck mode's viscous
+    // part (ξ = 0.4 1/s).
+    assert!(p80.xi > 3.5 && p80.xi < 3.8, "ξ = {}", p80.xi);
 }

@@ -11,7 +11,7 @@ use std::io::{BufWriter, Write};
 
 /// Write the mode `f` of `sc`, with its JSON document `doc`, into `stage`:
 /// `nma.csv` (per amplitude: `modal_amplitude`, `freq_hz`, `xi`,
-/// `damping_ratio`, `amplitude_<state>`…, `residual`, `sticks`).
+/// `damping_ratio`, `amplitude_<state>`…, `residual`, `sticks`, `stick_constraint`).
 pub fn write(stage: &Staging, f: &NmaFound, sc: &Scenario, doc: &Value) -> Result<(), RunError> {
     let path = stage.path("nma.csv");
     let io = |e: std::io::Error| RunError::Io(format!("cannot write {}: {e}", path.display()));
@@ -21,7 +21,7 @@ pub fn write(stage: &Staging, f: &NmaFound, sc: &Scenario, doc: &Value) -> Resul
         .map(String::from)
         .to_vec();
     header.extend(f.names.iter().map(|s| format!("amplitude_{s}")));
-    header.extend(["residual", "sticks"].map(String::from));
+    header.extend(["residual", "sticks", "stick_constraint"].map(String::from));
     writeln!(w, "{}", header.join(",")).map_err(io)?;
     for r in &f.rows {
         let mut row = vec![
@@ -33,6 +33,7 @@ pub fn write(stage: &Staging, f: &NmaFound, sc: &Scenario, doc: &Value) -> Resul
         row.extend(r.amplitude.iter().map(|a| format!("{a:e}")));
         row.push(format!("{:e}", r.residual));
         row.push(r.sticks.to_string());
+        row.push(r.stick_constraint.to_string());
         writeln!(w, "{}", row.join(",")).map_err(io)?;
     }
     w.flush().map_err(io)?;

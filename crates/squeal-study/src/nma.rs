@@ -33,9 +33,12 @@ pub struct NmaRow {
     pub amplitude: Vec<f64>,
     /// Scaled HB residual.
     pub residual: f64,
-    /// Whether a contact sticks somewhere on the orbit (HB treats it as
-    /// slip at zero speed: the point is then not exact).
+    /// Whether a contact sticks somewhere on the orbit.
     pub sticks: bool,
+    /// Whether stick was a constraint (the dynamic Lagrangian step): an
+    /// orbit that sticks is then exact in the limit of many harmonics;
+    /// without it HB treats stick as slip at zero speed (not exact).
+    pub stick_constraint: bool,
 }
 
 /// A nonlinear mode over amplitudes.
@@ -141,12 +144,28 @@ pub fn of_scenario(
         ..HbOptions::default()
     };
     let q0: Vec<f64> = z_static[..n].to_vec();
+    // A regularised law never sticks: stick as a constraint is tried only
+    // where a contact can stick.
+    let can_stick = l
+        .contacts
+        .iter()
+        .any(|c| !matches!(c.friction, squeal_core::FrictionLaw::Tanh { .. }));
     let (rows, failures) = crate::with_sim_system!(&sc.model, m => {
-        sweep(m, &stuck.mass, &phi, &q0, w, xi0, amplitudes, &opts, cancel)?
+        sweep(m, &stuck.mass, &phi, &q0, w, xi0, amplitudes, &opts, can_stick, cancel)?
     }, else => return Err(StudyError::Input(InputError(sc.model.check_cycle_size().err().unwrap_or_default()))));
-    if rows.iter().any(|r| r.sticks) {
+    let inexact: Vec<f64> = rows
+        .iter()
+        .filter(|r| r.sticks && !r.stick_constraint)
+        .map(|r| r.modal_amplitude)
+        .collect();
+    if !inexact.is_empty() {
+        warnings.push(format!(
+            "a contact sticks on the orbits at modal amplitudes {inexact:?}, where stick as a constraint (the dynamic Lagrangian step) did not converge: there harmonic balance treats stick as slip at zero speed, so those points are not exact"
+        ));
+    }
+    if rows.iter().any(|r| r.stick_constraint) {
         warnings.push(
-            "a contact sticks on some orbits: harmonic balance here treats stick as slip at zero speed, so those points are not exact (use a regularised law, friction = \"tanh\")".into(),
+            "where a contact sticks on the orbit (points marked sticks), stick is a constraint (dynamic Lagrangian step): the kinks at stick make the convergence in the harmonics algebraic; compare a higher --harmonics".into(),
         );
     }
     Ok(NmaFound {
@@ -174,6 +193,7 @@ fn sweep<M: System<N> + ?Sized, const N: usize>(
     xi0: f64,
     amplitudes: &[f64],
     opts: &HbOptions,
+    can_stick: bool,
     cancel: &Cancel,
 ) -> Result<Swept, StudyError> {
     let real = crate::cycle::real_states::<N>(m.norm_states());
@@ -191,15 +211,33 @@ fn sweep<M: System<N> + ?Sized, const N: usize>(
         }
         (g, *xi)
     };
+    // Friction as slip first (cheaper, exact where nothing sticks); an
+    // orbit that sticks, or a point where that fails, again with stick as
+    // a constraint from the same start (as `squeal hb` does).
+    let stick_opts = HbOptions {
+        lagrangian: true,
+        ..*opts
+    };
+    let solve = |a: f64, g: &Fourier, xi: f64| {
+        let slip = nonlinear_mode(m, mass, phi, a, (g, xi), opts);
+        match &slip {
+            _ if !can_stick => slip,
+            Ok(p) if !p.orbit.sticks => slip,
+            Ok(p) => {
+                nonlinear_mode(m, mass, phi, a, (&p.orbit.fourier, p.xi), &stick_opts).or(slip)
+            }
+            Err(_) => nonlinear_mode(m, mass, phi, a, (g, xi), &stick_opts).or(slip),
+        }
+    };
     for &a in amplitudes {
         cancel.check()?;
         let linear = mode_guess(q0, phi, w, a);
         let mut tried: Result<ModePoint, _> = match &last {
             Some(l) => {
                 let (g, xi) = scaled(l, a);
-                nonlinear_mode(m, mass, phi, a, (&g, xi), opts)
+                solve(a, &g, xi)
             }
-            None => nonlinear_mode(m, mass, phi, a, (&linear, xi0), opts),
+            None => solve(a, &linear, xi0),
         };
         // Where the mode changes fast (a damper going from stick to slip),
         // walk to `a` in geometrically halved steps from the last solution
@@ -212,7 +250,7 @@ fn sweep<M: System<N> + ?Sized, const N: usize>(
                 left -= 1;
                 let next = (from.2 * step.exp()).min(a);
                 let (g, xi) = scaled(&from, next);
-                match nonlinear_mode(m, mass, phi, next, (&g, xi), opts) {
+                match solve(next, &g, xi) {
                     Ok(p) => {
                         from = (p.orbit.fourier.clone(), p.xi, next);
                         step = (step * 1.5).min((a / next).ln().max(0.0));
@@ -229,7 +267,7 @@ fn sweep<M: System<N> + ?Sized, const N: usize>(
             }
         }
         if tried.is_err() {
-            tried = nonlinear_mode(m, mass, phi, a, (&linear, xi0), opts);
+            tried = solve(a, &linear, xi0);
         }
         match tried {
             Ok(p) => {
@@ -242,6 +280,7 @@ fn sweep<M: System<N> + ?Sized, const N: usize>(
                     amplitude: real.iter().map(|&i| amp[i]).collect(),
                     residual: p.orbit.residual,
                     sticks: p.orbit.sticks,
+                    stick_constraint: p.orbit.lagrangian,
                 });
                 last = Some((p.orbit.fourier, p.xi, a));
             }
@@ -254,7 +293,7 @@ fn sweep<M: System<N> + ?Sized, const N: usize>(
 impl NmaFound {
     /// The JSON document: `mode`, `linear_hz`, `harmonic_count`, `points`
     /// (per amplitude `modal_amplitude`, `freq_hz`, `xi`, `damping_ratio`,
-    /// `amplitude` per state, `residual`, `sticks`), `failures` and
+    /// `amplitude` per state, `residual`, `sticks`, `stick_constraint`), `failures` and
     /// `warnings`.
     pub fn to_json(&self) -> Value {
         let points: Vec<Value> = self
@@ -269,6 +308,7 @@ impl NmaFound {
                     "amplitude": crate::cycle::named_json(&self.names, &r.amplitude),
                     "residual": r.residual,
                     "sticks": r.sticks,
+                    "stick_constraint": r.stick_constraint,
                 })
             })
             .collect();

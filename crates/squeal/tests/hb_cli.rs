@@ -408,6 +408,54 @@ fn the_friction_dampers_nonlinear_mode() {
     }
 }
 
+/// The same damper with exact Coulomb friction: where it sticks on part of
+/// the period, stick is a constraint (before, those amplitudes failed or
+/// were flagged as inexact). Below the stick-slip threshold the damper
+/// never slips: the stuck mode exactly (ξ = c₁ + c₂); above it, the
+/// sliding tail equals the tanh law's (ε = 10⁻⁴) to 1e-5.
+#[test]
+fn a_coulomb_dampers_nonlinear_mode_sticks_as_a_constraint() {
+    let d = tempfile::tempdir().unwrap();
+    let sc = lumped("friction-damper");
+    let coulomb = [
+        "--set",
+        "damper.friction=coulomb",
+        "--set",
+        "damper.mu_s=1",
+        "--set",
+        "damper.mu_k=1",
+    ];
+    let run = |extra: &[&str]| {
+        json_of(&squeal(
+            d.path(),
+            &[
+                &["nma", &sc, "--modal-amplitude", "1e-3:1e-2:7", "--json"][..],
+                extra,
+            ]
+            .concat(),
+        ))
+    };
+    let v = run(&coulomb);
+    let pts = v["points"].as_array().unwrap();
+    assert_eq!(pts.len(), 7, "{}", v["failures"]);
+    let f = |i: usize, k: &str| pts[i][k].as_f64().unwrap();
+    let stuck = 2e4f64.sqrt() / std::f64::consts::TAU;
+    assert!((f(0, "freq_hz") / stuck - 1.0).abs() < 1e-9);
+    assert!((f(0, "xi") / 0.4 - 1.0).abs() < 1e-9, "{}", f(0, "xi"));
+    for p in pts {
+        assert_eq!(p["sticks"], p["stick_constraint"], "{p}");
+    }
+    assert!(pts
+        .iter()
+        .any(|p| p["stick_constraint"] == true && p["xi"].as_f64().unwrap() > 1.0));
+    let tanh = run(&[]);
+    let (a, b) = (
+        f(6, "freq_hz"),
+        tanh["points"][6]["freq_hz"].as_f64().unwrap(),
+    );
+    assert!((a / b - 1.0).abs() < 1e-5, "{a} vs {b}");
+}
+
 /// `hb --param` from a Hopf point: with no orbit at LO (steady sliding is
 /// stable there), the branch starts at `critical`'s Hopf point inside the
 /// range. On the belt with the (exponential) Stribeck law the Hopf point is

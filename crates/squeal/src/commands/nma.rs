@@ -71,7 +71,11 @@ fn print_human(f: &NmaFound, sc: &Scenario) {
             r.freq_hz,
             r.damping_ratio,
             r.xi,
-            if r.sticks { "  (sticks)" } else { "" }
+            match (r.sticks, r.stick_constraint) {
+                (false, _) => "",
+                (true, true) => "  (sticks: a constraint)",
+                (true, false) => "  (sticks: as slip, not exact)",
+            }
         );
     }
     for (a, why) in &f.failures {
