@@ -375,3 +375,50 @@ fn forced_oscillators_that_stick_simulate_and_balance() {
     }
     assert!(errs[3].abs() < 2e-3, "{errs:?}");
 }
+
+/// Den Hartog's oscillator at rest forced with `F = μN` exactly: the stick
+/// force `F cos Ωt` touches the friction limit at t = 0 without crossing
+/// it (the mass stays stuck). The event search of a forced (non-affine)
+/// stick guard cannot certify a touching zero; the run ends with the error
+/// that says so, at the time and guard, instead of a bare step underflow.
+#[test]
+fn a_force_peak_exactly_at_the_friction_limit_is_named_as_a_grazing() {
+    use squeal_core::integrate::{simulate, IntegrateError, SolverOptions};
+    let l = oscillator(1.0, 1.0e4, 0.0, 0.0, 3.0, 150.0 / TAU, Some(3.0));
+    let mut out = squeal_core::sink::Discard;
+    let err = simulate(
+        &Fixed::<2>(&l),
+        0.0,
+        [0.0, 0.0],
+        0.1,
+        1000.0,
+        SolverOptions::default(),
+        &mut out,
+    )
+    .unwrap_err();
+    match err {
+        IntegrateError::EventSearch {
+            t,
+            ref contact,
+            surface,
+        } => {
+            assert_eq!((t, contact.as_str(), surface), (0.0, "rub", "stick bound"));
+        }
+        other => panic!("{other}"),
+    }
+    // A force clearly below the limit: stuck all along, no event.
+    let l = oscillator(1.0, 1.0e4, 0.0, 0.0, 2.9, 150.0 / TAU, Some(3.0));
+    let mut out = squeal_core::sink::Discard;
+    let info = simulate(
+        &Fixed::<2>(&l),
+        0.0,
+        [0.0, 0.0],
+        0.1,
+        1000.0,
+        SolverOptions::default(),
+        &mut out,
+    )
+    .unwrap();
+    assert_eq!(info.stats.events.iter().sum::<u64>(), 0, "{info:?}");
+    assert_eq!(info.t_final, 0.1);
+}

@@ -71,6 +71,23 @@ pub enum IntegrateError {
         /// Transitions in a row without progress.
         count: u32,
     },
+    /// The event search of a guard that is not affine gave up on every step
+    /// down to round-off of the time: the guard stays within round-off of
+    /// zero without crossing it clearly (a grazing).
+    #[error(
+        "the event search gave up at t = {t:.9e} s: contact {contact}'s {surface} guard stays at \
+         zero without a clear crossing (a grazing: e.g. the stick force's peak exactly at the \
+         friction limit μ_s·F_n), and no step short enough certifies it; change the load or the \
+         force slightly"
+    )]
+    EventSearch {
+        /// Time (s).
+        t: f64,
+        /// The contact's name.
+        contact: String,
+        /// Its guard's surface (as [`IntegrateError::Stalled`]'s).
+        surface: &'static str,
+    },
     /// The state became NaN or infinite.
     #[error("the state became non-finite at t = {t:.9e} s")]
     NonFinite {
@@ -216,6 +233,9 @@ pub struct Solver<'m, M: System<N> + ?Sized, const N: usize> {
     zeno_run: u32,
     /// Transitions in a row that changed no mode and advanced no time.
     stall_run: u32,
+    /// 1 + the index of the guard whose event search gave up on the last
+    /// attempt (the step was retried shorter); 0 if none.
+    gave_up: u32,
     /// Events fired while settling a mode (at most [`SETTLE_LIMIT`]), oldest first.
     pending: [Pending<N>; SETTLE_LIMIT],
     pending_len: usize,
@@ -302,6 +322,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             last_event_t: f64::NEG_INFINITY,
             zeno_run: 0,
             stall_run: 0,
+            gave_up: 0,
             pending: [(EventKind::Stick, 0, [0.0; N], modes); SETTLE_LIMIT],
             pending_len: 0,
             pending_next: 0,
@@ -714,6 +735,17 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
             hits_stop = true;
         }
         if h < self.h_min() && !hits_stop {
+            if let Some(g) = self
+                .gave_up
+                .checked_sub(1)
+                .map(|i| self.guards.as_slice()[i as usize])
+            {
+                return Err(IntegrateError::EventSearch {
+                    t: self.t,
+                    contact: self.model.contact_name(g.contact as usize).to_string(),
+                    surface: surface_name(g.kind),
+                });
+            }
             return Err(IntegrateError::StepUnderflow { t: self.t, h });
         }
         Ok((h, hits_stop))
@@ -800,6 +832,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                     Ok(found) => found,
                     Err(()) => {
                         // The bound is too loose on a step this long: retry at a quarter.
+                        self.gave_up = gi as u32 + 1;
                         self.stats.accepted -= 1;
                         self.stats.rejected += 1;
                         self.last_rejected = true;
@@ -814,6 +847,7 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
                 }
             }
         }
+        self.gave_up = 0;
         self.finish(h, t_stop, z_new, first).map(Some)
     }
 
@@ -901,16 +935,10 @@ impl<'m, M: System<N> + ?Sized, const N: usize> Solver<'m, M, N> {
         if self.stall_run < self.opts.zeno_count {
             return Ok(());
         }
-        let surface = match g.kind {
-            GuardKind::SlipZero => "v_rel = 0",
-            GuardKind::StickBreakPos | GuardKind::StickBreakNeg => "stick bound",
-            GuardKind::Separation => "F_n = 0",
-            GuardKind::Contact => "gap = 0",
-        };
         Err(IntegrateError::Stalled {
             t: t1,
             contact: self.model.contact_name(g.contact as usize).to_string(),
-            surface,
+            surface: surface_name(g.kind),
             count: self.stall_run,
         })
     }
@@ -1032,6 +1060,16 @@ fn power_basis(g0: f64, g: &[f64; 7]) -> [f64; 8] {
     }
     p[0] += g0;
     p
+}
+
+/// A guard's surface, as errors name it.
+fn surface_name(kind: GuardKind) -> &'static str {
+    match kind {
+        GuardKind::SlipZero => "v_rel = 0",
+        GuardKind::StickBreakPos | GuardKind::StickBreakNeg => "stick bound",
+        GuardKind::Separation => "F_n = 0",
+        GuardKind::Contact => "gap = 0",
+    }
 }
 
 /// The bit of [`Solver::enter_mode`]'s `broke` that guard `g` sets when it
