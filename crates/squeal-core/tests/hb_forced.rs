@@ -383,20 +383,23 @@ fn forced_oscillators_that_stick_simulate_and_balance() {
 /// that says so, at the time and guard, instead of a bare step underflow.
 #[test]
 fn a_force_peak_exactly_at_the_friction_limit_is_named_as_a_grazing() {
-    use squeal_core::integrate::{simulate, IntegrateError, SolverOptions};
-    let l = oscillator(1.0, 1.0e4, 0.0, 0.0, 3.0, 150.0 / TAU, Some(3.0));
-    let mut out = squeal_core::sink::Discard;
-    let err = simulate(
-        &Fixed::<2>(&l),
-        0.0,
-        [0.0, 0.0],
-        0.1,
-        1000.0,
-        SolverOptions::default(),
-        &mut out,
-    )
-    .unwrap_err();
-    match err {
+    use squeal_core::integrate::{simulate, IntegrateError, RunInfo, SolverOptions};
+    // 0.1 s from rest, forced with amplitude `f` against μN = 3 N.
+    let run = |f: f64| -> Result<RunInfo, IntegrateError> {
+        let l = oscillator(1.0, 1.0e4, 0.0, 0.0, f, 150.0 / TAU, Some(3.0));
+        let mut out = squeal_core::sink::Discard;
+        let opts = SolverOptions::default();
+        simulate(
+            &Fixed::<2>(&l),
+            0.0,
+            [0.0, 0.0],
+            0.1,
+            1000.0,
+            opts,
+            &mut out,
+        )
+    };
+    match run(3.0).unwrap_err() {
         IntegrateError::EventSearch {
             t,
             ref contact,
@@ -407,18 +410,7 @@ fn a_force_peak_exactly_at_the_friction_limit_is_named_as_a_grazing() {
         other => panic!("{other}"),
     }
     // A force clearly below the limit: stuck all along, no event.
-    let l = oscillator(1.0, 1.0e4, 0.0, 0.0, 2.9, 150.0 / TAU, Some(3.0));
-    let mut out = squeal_core::sink::Discard;
-    let info = simulate(
-        &Fixed::<2>(&l),
-        0.0,
-        [0.0, 0.0],
-        0.1,
-        1000.0,
-        SolverOptions::default(),
-        &mut out,
-    )
-    .unwrap();
+    let info = run(2.9).unwrap();
     assert_eq!(info.stats.events.iter().sum::<u64>(), 0, "{info:?}");
     assert_eq!(info.t_final, 0.1);
 }
