@@ -3,7 +3,8 @@
 //! and with the scaled tolerances the real dofs move as in the exact size.
 
 use squeal_core::model::lumped::{
-    disc_pad_spec, padded_dofs, padded_solver, LumpedSpec, SpringSpec, MAX_EXACT_DOFS, MAX_SIM_DOFS,
+    disc_pad_spec, padded_dofs, padded_solver, transient_padded_dofs, LumpedSpec, SpringSpec,
+    MAX_EXACT_DOFS, MAX_SIM_DOFS, MAX_TRANSIENT_DOFS,
 };
 use squeal_core::sink::{EventLog, Recorder};
 // `padded_solver` only moves per-state tolerances; these runs have none.
@@ -37,6 +38,85 @@ fn padded_sizes_cover_every_model_up_to_the_limit() {
     assert_eq!(padded_dofs(64), Some(64));
     assert_eq!(padded_dofs(65), Some(96));
     assert_eq!(padded_dofs(128), Some(128));
+    // Transient runs go on in larger sizes, limit cycles do not.
+    for dofs in 1..=MAX_SIM_DOFS {
+        assert_eq!(transient_padded_dofs(dofs), None, "{dofs} dofs");
+    }
+    for dofs in MAX_SIM_DOFS + 1..=MAX_TRANSIENT_DOFS {
+        let p = transient_padded_dofs(dofs).unwrap_or_else(|| panic!("{dofs} dofs: no size"));
+        assert!(p >= dofs && p <= MAX_TRANSIENT_DOFS, "{dofs} → {p}");
+        assert_eq!(padded_dofs(dofs), None);
+    }
+    assert_eq!(transient_padded_dofs(MAX_TRANSIENT_DOFS + 1), None);
+    assert_eq!(transient_padded_dofs(129), Some(192));
+    assert_eq!(transient_padded_dofs(187), Some(192));
+    assert_eq!(transient_padded_dofs(512), Some(512));
+}
+
+/// The disc–pad padded from 4 to the largest transient size (512 dofs,
+/// 1024 states: the largest arrays the integrator is compiled for, run on a
+/// test thread's stack) over 0.1 s of stick-slip is bit for bit the same
+/// model padded to the smallest padded size (24 dofs): steps, every event,
+/// every sample; the idle states stay zero. (Both evaluate the force on the
+/// general path; the exact 4-dof size uses the folded operators of
+/// `DENSE_FIELD_DOFS`, whose sums are associated differently, so against it
+/// the steps are the same and the events agree to 1e-12 s.)
+#[test]
+fn the_largest_transient_size_is_the_smallest_padded_run_bit_for_bit() {
+    let lp = disc_pad_at_n_2000();
+    let opts = disc_pad_opts();
+    let (small, large) = (lp.padded_to(24), lp.padded_to(MAX_TRANSIENT_DOFS));
+    let (mut a, mut b, mut e) = (
+        Recorder::<48>::new(),
+        Recorder::<1024>::new(),
+        Recorder::<8>::new(),
+    );
+    let ia = simulate(
+        &small,
+        0.0,
+        [0.0; 48],
+        0.1,
+        1000.0,
+        padded_solver::<48>(&opts, 8),
+        &mut a,
+    );
+    let ib = simulate(
+        &large,
+        0.0,
+        [0.0; 1024],
+        0.1,
+        1000.0,
+        padded_solver::<1024>(&opts, 8),
+        &mut b,
+    );
+    let (ia, ib) = (ia.unwrap(), ib.unwrap());
+    let ie = simulate(&lp, 0.0, [0.0; 8], 0.1, 1000.0, opts, &mut e).unwrap();
+    let counts = |i: &squeal_core::RunInfo| (i.stats.accepted, i.stats.rejected, i.stats.rhs_evals);
+    assert_eq!(counts(&ia), counts(&ib));
+    assert_eq!(counts(&ia), counts(&ie));
+    assert!(a.events.len() > 500, "only {} events", a.events.len());
+    assert_eq!(a.events.len(), b.events.len());
+    assert_eq!(a.events.len(), e.events.len());
+    let real = |z: &[f64]| -> Vec<f64> {
+        let h = z.len() / 2;
+        z[..4].iter().chain(&z[h..h + 4]).copied().collect()
+    };
+    let idle_zero = |z: &[f64]| {
+        let h = z.len() / 2;
+        (4..h).chain(h + 4..z.len()).all(|i| z[i] == 0.0)
+    };
+    for ((x, y), w) in a.events.iter().zip(&b.events).zip(&e.events) {
+        assert_eq!((x.kind, x.contact, x.t), (y.kind, y.contact, y.t));
+        assert_eq!(real(&x.z), real(&y.z));
+        assert!(idle_zero(&x.z) && idle_zero(&y.z));
+        assert_eq!((x.kind, x.contact), (w.kind, w.contact));
+        assert!((x.t - w.t).abs() <= 1e-12, "{} vs {}", x.t, w.t);
+    }
+    assert_eq!(a.t, b.t);
+    for (x, y) in a.z.iter().zip(&b.z) {
+        assert_eq!(real(x), real(y));
+        assert!(idle_zero(y));
+    }
 }
 
 /// The disc–pad at N = 2000 (stick-slip from rest, over 12 000 events in

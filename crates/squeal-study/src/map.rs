@@ -572,7 +572,7 @@ fn prepared(sc: &Scenario, x: &Axis, y: &Axis, k: usize) -> Result<Scenario, Str
 
 /// The transient run of a prepared point, one at a time.
 fn run_prepared(s: &Scenario) -> Result<Outcome, String> {
-    crate::with_sim_system!(&s.model, m => transient_point(m, s),
+    crate::with_transient_system!(&s.model, m => transient_point(m, s),
         else => Err(s.model.check_simulable().err().unwrap_or_default()))
 }
 

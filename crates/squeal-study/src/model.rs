@@ -1,6 +1,6 @@
 //! The models the command line knows, behind one enum, with their output columns.
 
-use squeal_core::model::lumped::MAX_SIM_DOFS;
+use squeal_core::model::lumped::{MAX_SIM_DOFS, MAX_TRANSIENT_DOFS};
 use squeal_core::model::{Modes, Observables};
 use squeal_core::params::ParamKind;
 use squeal_core::stability::{self, Analysis, Inertia, StabilityError};
@@ -73,6 +73,23 @@ macro_rules! with_sim_system {
                 squeal_core::with_lumped_size!(&**l, $m => $body,
                     else => squeal_core::with_padded_size!(&**l, $m => $body, else => $fallback))
             }
+        }
+    };
+}
+
+/// As [`with_sim_system!`](crate::with_sim_system), for transient runs only
+/// (`simulate`, `listen`, `map --transient`): a lumped model of more than
+/// `MAX_SIM_DOFS` (and at most `MAX_TRANSIENT_DOFS`) dofs runs in one of the
+/// larger padded sizes (`squeal_core::model::lumped::TRANSIENT_PADDED_DOFS`),
+/// compiled for these runs alone (a limit cycle of that size is refused).
+#[macro_export]
+macro_rules! with_transient_system {
+    ($any:expr, $m:ident => $body:expr, else => $fallback:expr) => {
+        match $any {
+            $crate::model::AnyModel::Lumped(l) if l.dof_count() > squeal_core::model::lumped::MAX_SIM_DOFS => {
+                squeal_core::with_transient_padded_size!(&**l, $m => $body, else => $fallback)
+            }
+            any => $crate::with_sim_system!(any, $m => $body, else => $fallback),
         }
     };
 }
@@ -189,11 +206,11 @@ impl AnyModel {
             _ => channels_for(self.name()),
         }
     }
-    /// Whether the model can be simulated (lumped: at most `MAX_SIM_DOFS` dofs).
+    /// Whether the model can be simulated (lumped: at most `MAX_TRANSIENT_DOFS` dofs).
     pub fn check_simulable(&self) -> Result<(), String> {
         match self {
-            AnyModel::Lumped(l) if l.dof_count() > MAX_SIM_DOFS => Err(format!(
-                "this lumped model has {} dofs: simulation supports up to {MAX_SIM_DOFS} dofs (stability, map, critical and sweep work for any size; `squeal reduce` makes a Craig–Bampton model of it with the contact dofs kept, which simulates)",
+            AnyModel::Lumped(l) if l.dof_count() > MAX_TRANSIENT_DOFS => Err(format!(
+                "this lumped model has {} dofs: simulation supports up to {MAX_TRANSIENT_DOFS} dofs (stability, map, critical and sweep work for any size; `squeal reduce` makes a Craig–Bampton model of it with the contact dofs kept, which simulates)",
                 l.dof_count()
             )),
             _ => Ok(()),
@@ -201,11 +218,11 @@ impl AnyModel {
     }
     /// Whether the model's limit cycles can be analysed (`cycle`, `branch`:
     /// Floquet multipliers on fixed-size states; lumped: at most
-    /// `MAX_SIM_DOFS` dofs, as simulation).
+    /// `MAX_SIM_DOFS` dofs; transient runs go to `MAX_TRANSIENT_DOFS`).
     pub fn check_cycle_size(&self) -> Result<(), String> {
         match self {
             AnyModel::Lumped(l) if l.dof_count() > MAX_SIM_DOFS => Err(format!(
-                "this lumped model has {} dofs: cycle and branch support up to {MAX_SIM_DOFS} dofs, as simulate and map --transient (stability, map, critical and sweep any size; `squeal reduce` with a lower modal.cutoff_hz makes a smaller Craig–Bampton model of it)",
+                "this lumped model has {} dofs: cycle and branch support up to {MAX_SIM_DOFS} dofs (their Floquet analysis costs the cube of the state count per step; simulate, listen and map --transient go to {MAX_TRANSIENT_DOFS}, stability, map, critical and sweep any size; `squeal reduce` with a lower modal.cutoff_hz makes a smaller Craig–Bampton model of it)",
                 l.dof_count()
             )),
             _ => Ok(()),

@@ -270,7 +270,7 @@ pub fn explain(e: squeal_core::IntegrateError, duration: f64) -> String {
 /// reporting thousandths of its duration to `progress`, stopping with
 /// [`StudyError::Interrupted`] soon after `cancel` is set.
 pub fn run(sc: &Scenario, progress: &dyn Progress, cancel: &Cancel) -> Result<Run, StudyError> {
-    crate::with_sim_system!(&sc.model, m => run_model(m, &sc.model, sc, progress, cancel),
+    crate::with_transient_system!(&sc.model, m => run_model(m, &sc.model, sc, progress, cancel),
         else => Err(StudyError::Input(InputError(sc.model.check_simulable().err().unwrap_or_default()))))
 }
 

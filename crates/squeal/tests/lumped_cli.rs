@@ -345,30 +345,42 @@ mu_k = 0.3
     );
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("modal.modes"));
-    // Simulation is refused for a model this size, with the limit stated.
-    let out = squeal(d.path(), &["simulate", "big.toml", "--out", "x"]);
-    assert_eq!(out.status.code(), Some(2));
-    let e = String::from_utf8_lossy(&out.stderr);
-    assert!(e.contains("300 dofs") && e.contains("up to 128"), "{e}");
-    assert!(!d.path().join("x").exists());
-    // So are cycles (their Floquet analysis runs in the same sizes).
+    // Cycles are refused for a model this size, with the limit stated
+    // (simulation runs it: `a_150_dof_file_simulates_in_a_transient_size…`).
     let out = squeal(d.path(), &["cycle", "big.toml"]);
     assert_eq!(out.status.code(), Some(2));
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(e.contains("300 dofs") && e.contains("up to 128"), "{e}");
 }
 
-/// A 20-dof lumped file (the disc–pad plus a separate chain of 16 masses,
-/// ringing from a displacement): `simulate` runs it (padded to 24 dofs
-/// inside, see `squeal_core::model::lumped::padding`) and writes exactly the
-/// file's dofs; its disc–pad moves as the 4-dof file's does (RMS to 1e-6:
-/// the steps differ because the error norm also weighs the chain); `map
-/// --transient` runs it.
-#[test]
-fn a_20_dof_file_simulates_and_maps() {
-    let d = tempfile::tempdir().unwrap();
+/// `series.csv` of the run in `dir`: its header and rows.
+fn read_series(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(dir.join("series.csv")).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    (head, rows)
+}
+
+/// Index of column `name` in header `h`.
+fn col(h: &[String], name: &str) -> usize {
+    h.iter().position(|c| c == name).unwrap()
+}
+
+/// RMS of column `name` over rows `r`.
+fn rms(h: &[String], r: &[Vec<f64>], name: &str) -> f64 {
+    let c = col(h, name);
+    (r.iter().map(|row| row[c] * row[c]).sum::<f64>() / r.len() as f64).sqrt()
+}
+
+/// The disc–pad scenario file with a separate chain of `links` masses
+/// (`c1`…, 0.5 kg on 1e6 N/m springs), `c1` starting displaced by 1 mm; and
+/// the chain's dof names.
+fn disc_pad_with_chain(links: usize) -> (String, Vec<String>) {
     let base = std::fs::read_to_string(scenarios().join("disc-pad.toml")).unwrap();
-    let chain: Vec<String> = (1..=16).map(|i| format!("c{i}")).collect();
+    let chain: Vec<String> = (1..=links).map(|i| format!("c{i}")).collect();
     let mut text = base.replace(
         r#"dofs = ["x_d", "x_p", "y_d", "y_p"]"#,
         &format!(
@@ -403,6 +415,19 @@ fn a_20_dof_file_simulates_and_maps() {
         ));
     }
     text.push_str("\n[offsets]\nc10 = 1e-3\n"); // c1 starts displaced (offset keys are <state>0)
+    (text, chain)
+}
+
+/// A 20-dof lumped file (the disc–pad plus a separate chain of 16 masses,
+/// ringing from a displacement): `simulate` runs it (padded to 24 dofs
+/// inside, see `squeal_core::model::lumped::padding`) and writes exactly the
+/// file's dofs; its disc–pad moves as the 4-dof file's does (RMS to 1e-6:
+/// the steps differ because the error norm also weighs the chain); `map
+/// --transient` runs it.
+#[test]
+fn a_20_dof_file_simulates_and_maps() {
+    let d = tempfile::tempdir().unwrap();
+    let (text, chain) = disc_pad_with_chain(16);
     std::fs::write(d.path().join("big20.toml"), &text).unwrap();
     let args = ["--duration", "0.1", "--no-plots", "--format", "csv"];
     let mut a = vec!["simulate", "big20.toml", "--out", "b20"];
@@ -412,17 +437,8 @@ fn a_20_dof_file_simulates_and_maps() {
     let mut a = vec!["simulate", small.to_str().unwrap(), "--out", "b4"];
     a.extend(args);
     ok(&squeal(d.path(), &a));
-    let read = |dir: &str| -> (Vec<String>, Vec<Vec<f64>>) {
-        let text = std::fs::read_to_string(d.path().join(dir).join("series.csv")).unwrap();
-        let mut lines = text.lines();
-        let head: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-        let rows = lines
-            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
-            .collect();
-        (head, rows)
-    };
-    let (h20, r20) = read("b20");
-    let (h4, r4) = read("b4");
+    let (h20, r20) = read_series(&d.path().join("b20"));
+    let (h4, r4) = read_series(&d.path().join("b4"));
     let mut want = vec!["t".to_string()];
     for q in ["x_d", "x_p", "y_d", "y_p"]
         .iter()
@@ -443,13 +459,8 @@ fn a_20_dof_file_simulates_and_maps() {
     }
     assert_eq!(h20, want, "series.csv columns");
     assert_eq!(r20.len(), r4.len());
-    let col = |h: &[String], name: &str| h.iter().position(|c| c == name).unwrap();
     for name in ["vx_d", "vx_p", "vy_d", "vy_p"] {
-        let rms = |h: &[String], r: &[Vec<f64>]| {
-            let c = col(h, name);
-            (r.iter().map(|row| row[c] * row[c]).sum::<f64>() / r.len() as f64).sqrt()
-        };
-        let (x, y) = (rms(&h4, &r4), rms(&h20, &r20));
+        let (x, y) = (rms(&h4, &r4, name), rms(&h20, &r20, name));
         assert!((x - y).abs() <= 1e-6 * x, "{name}: RMS {x:e} vs {y:e}");
     }
     let c16 = col(&h20, "c16");
@@ -477,6 +488,75 @@ fn a_20_dof_file_simulates_and_maps() {
     let map = std::fs::read_to_string(d.path().join("m20/map.csv")).unwrap();
     assert_eq!(map.lines().count(), 5, "{map}");
     assert!(!map.contains("failed"), "{map}");
+}
+
+/// A 150-dof lumped file (the disc–pad plus a chain of 146 masses) is above
+/// the limit-cycle sizes (128 dofs) and runs in a transient-only padded size
+/// (192 dofs, `padding::TRANSIENT_PADDED_DOFS`): `simulate` writes the file's
+/// dofs, its disc–pad moves as the 4-dof file's (RMS to 1e-5) and the
+/// chain's wave travels; `cycle` is refused with its own limit, and a 513-dof file
+/// (above `MAX_TRANSIENT_DOFS`) is refused by `simulate` naming both, with no
+/// output.
+#[test]
+fn a_150_dof_file_simulates_in_a_transient_size_and_cycles_are_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let (text, chain) = disc_pad_with_chain(146);
+    std::fs::write(d.path().join("big150.toml"), &text).unwrap();
+    let args = ["--duration", "0.05", "--no-plots", "--format", "csv"];
+    let mut a = vec!["simulate", "big150.toml", "--out", "b150"];
+    a.extend(args);
+    let human = ok(&squeal(d.path(), &a));
+    // 150 velocities: the summary lists the 12 largest, summary.json all.
+    assert!(
+        human.contains("RMS velocity over the last 20 % (m/s), the largest: ")
+            && human.contains("… and 138 more in summary.json"),
+        "{human}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("b150/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["rms"].as_object().unwrap().len(), 150);
+    let small = scenarios().join("disc-pad.toml");
+    let mut a = vec!["simulate", small.to_str().unwrap(), "--out", "b4"];
+    a.extend(args);
+    ok(&squeal(d.path(), &a));
+    let (hb, rb) = read_series(&d.path().join("b150"));
+    let (h4, r4) = read_series(&d.path().join("b4"));
+    // t, 150 positions, 150 velocities, the contact's four columns.
+    assert_eq!(hb.len(), 1 + 300 + 4, "series.csv columns");
+    let idle = |c: &String| {
+        let q = c.strip_prefix('v').unwrap_or(c);
+        q.strip_prefix("pad.")
+            .is_some_and(|r| r.starts_with(|ch: char| ch.is_ascii_digit()))
+    };
+    assert!(!hb.iter().any(idle), "an idle dof was written: {hb:?}");
+    assert_eq!(rb.len(), r4.len());
+    for name in ["vx_d", "vx_p", "vy_d", "vy_p"] {
+        let (x, y) = (rms(&h4, &r4, name), rms(&hb, &rb, name));
+        // 1e-5: the error norm averages over 300 states instead of 8, so
+        // the disc–pad's own error may be √(300/8) ≈ 6× rtol's.
+        assert!((x - y).abs() <= 1e-5 * x, "{name}: RMS {x:e} vs {y:e}");
+    }
+    // A link passes the wave on in √(m/k) ≈ 0.7 ms: 0.05 s reaches c50.
+    let far = col(&hb, &chain[49]);
+    assert!(
+        rb.iter().any(|row| row[far].abs() > 1e-9),
+        "the chain's wave never reached c50"
+    );
+    let out = squeal(d.path(), &["cycle", "big150.toml"]);
+    assert_eq!(out.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        e.contains("150 dofs") && e.contains("up to 128") && e.contains("512"),
+        "{e}"
+    );
+    let (text, _) = disc_pad_with_chain(509);
+    std::fs::write(d.path().join("big513.toml"), &text).unwrap();
+    let out = squeal(d.path(), &["simulate", "big513.toml", "--out", "x"]);
+    assert_eq!(out.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("513 dofs") && e.contains("up to 512"), "{e}");
+    assert!(!d.path().join("x").exists());
 }
 
 #[test]

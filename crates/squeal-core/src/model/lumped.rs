@@ -452,6 +452,11 @@ pub const MAX_MODEL_DOFS: usize = 1_000_000;
 /// [`padding`]). Stability analysis works for any size.
 pub const MAX_SIM_DOFS: usize = 128;
 
+/// Most dofs a lumped model may have for a transient run (`simulate`,
+/// `listen`, `map --transient`): above [`MAX_SIM_DOFS`] it runs in one of the
+/// larger padded sizes of [`TRANSIENT_PADDED_DOFS`] (limit cycles do not).
+pub const MAX_TRANSIENT_DOFS: usize = 512;
+
 mod build;
 pub mod condense;
 mod folded;
@@ -467,7 +472,10 @@ mod specs;
 mod steady;
 mod system;
 pub use linearised::StuckModes;
-pub use padding::{embed, padded_dofs, padded_solver, real_states, MAX_EXACT_DOFS, PADDED_DOFS};
+pub use padding::{
+    embed, padded_dofs, padded_solver, real_states, transient_padded_dofs, MAX_EXACT_DOFS,
+    PADDED_DOFS, TRANSIENT_PADDED_DOFS,
+};
 use params::prefixed;
 pub use sparse::{Sparse, Triplets};
 pub use specs::{disc_pad_spec, two_pad_spec};

@@ -179,6 +179,9 @@ pub fn run(a: SimulateArgs) -> Result<(), RunError> {
     Ok(())
 }
 
+/// Most velocities the human summary lists (the largest by RMS).
+const SHOWN_SIGNALS: usize = 12;
+
 fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest: &std::path::Path) {
     let s = &run.info.stats;
     crate::outln!(
@@ -200,19 +203,43 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
         ev.join(", "),
         s.stick_fraction()
     );
-    if let Some(rms) = summary["rms"].as_object() {
-        let parts: Vec<String> = rms
+    // A large model (an FE brake's hundreds of velocities) lists its
+    // SHOWN_SIGNALS largest by RMS; summary.json has every one.
+    let rms = summary["rms"].as_object();
+    let shown: Option<Vec<&String>> = rms.map(|r| {
+        let mut keys: Vec<&String> = r.keys().collect();
+        if keys.len() > SHOWN_SIGNALS {
+            let v = |k: &String| r[k.as_str()].as_f64().unwrap_or(0.0);
+            keys.sort_by(|a, b| v(b).total_cmp(&v(a)));
+            keys.truncate(SHOWN_SIGNALS);
+        }
+        keys
+    });
+    let truncated = rms.is_some_and(|r| r.len() > SHOWN_SIGNALS);
+    let more = |total: usize, listed: usize| {
+        if truncated && total > listed {
+            format!(" … and {} more in summary.json", total - listed)
+        } else {
+            String::new()
+        }
+    };
+    if let (Some(rms), Some(shown)) = (rms, &shown) {
+        let parts: Vec<String> = shown
             .iter()
-            .map(|(k, v)| format!("{k} {:.3e}", v.as_f64().unwrap_or(0.0)))
+            .map(|k| format!("{k} {:.3e}", rms[k.as_str()].as_f64().unwrap_or(0.0)))
             .collect();
         crate::outln!(
-            "RMS velocity over the last 20 % (m/s): {}",
-            parts.join(", ")
+            "RMS velocity over the last 20 % (m/s){}: {}{}",
+            if truncated { ", the largest" } else { "" },
+            parts.join(", "),
+            more(rms.len(), parts.len())
         );
     }
     if let Some(sig) = summary["spectrum"]["signals"].as_object() {
+        let listed = |k: &String| shown.as_ref().is_none_or(|s| s.contains(&k));
         let dom: Vec<String> = sig
             .iter()
+            .filter(|(k, _)| listed(k))
             .filter_map(|(k, v)| {
                 v["dominant_hz"]
                     .as_f64()
@@ -221,8 +248,9 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
             .collect();
         if !dom.is_empty() {
             crate::outln!(
-                "spectral peaks (the strongest line of each velocity, not the squeal answer): {}",
-                dom.join(", ")
+                "spectral peaks (the strongest line of each velocity, not the squeal answer): {}{}",
+                dom.join(", "),
+                more(sig.len(), dom.len())
             );
         }
     }

@@ -15,6 +15,14 @@
 //! ([`System::norm_states`](crate::model::System::norm_states)), so a padded
 //! run takes the very steps of the unpadded one, bit for bit.
 //!
+//! Transient runs (not limit cycles) of still larger models, up to
+//! [`MAX_TRANSIENT_DOFS`](super::MAX_TRANSIENT_DOFS), run in one of
+//! [`TRANSIENT_PADDED_DOFS`] the same way ([`with_transient_padded_size!`](crate::with_transient_padded_size)):
+//! a reduced FE brake of a few hundred generalised dofs. Its cost per step
+//! is the real model's force evaluation (the sparse or dense `K`, `C` of its
+//! own size: the idle rows are empty) plus `O(N)` vector work per stage on
+//! the padded size.
+//!
 //! Simulation and limit cycles run padded. An eigen-analysis of the padded
 //! model would add the idle dofs' modes (±i rad/s), so stability uses the
 //! size-independent paths or the exact sizes; the Floquet analysis of
@@ -30,6 +38,13 @@ pub const MAX_EXACT_DOFS: usize = 16;
 /// The padded sizes (dofs) a larger model runs in, smallest first.
 pub const PADDED_DOFS: [usize; 6] = [24, 32, 48, 64, 96, 128];
 
+/// The larger padded sizes (dofs) for transient runs only (`simulate`,
+/// `listen`, `map --transient`), smallest first: above [`PADDED_DOFS`]'s
+/// last, up to [`MAX_TRANSIENT_DOFS`](super::MAX_TRANSIENT_DOFS). Limit
+/// cycles stop at [`MAX_SIM_DOFS`](super::MAX_SIM_DOFS): their Floquet
+/// analysis costs the cube of the state count per step.
+pub const TRANSIENT_PADDED_DOFS: [usize; 4] = [192, 256, 384, 512];
+
 /// Prefix of the idle dofs' names (`pad.1`, …): a `.` is not allowed in a
 /// user's dof name, so they never collide.
 pub const IDLE_PREFIX: &str = "pad.";
@@ -41,6 +56,16 @@ pub fn padded_dofs(dofs: usize) -> Option<usize> {
         return None;
     }
     PADDED_DOFS.iter().copied().find(|&p| p >= dofs)
+}
+
+/// The padded size (dofs) a transient run of a model of `dofs` dofs takes
+/// when it is larger than [`MAX_SIM_DOFS`](super::MAX_SIM_DOFS): `None` if
+/// it is not, or is too large (> [`MAX_TRANSIENT_DOFS`](super::MAX_TRANSIENT_DOFS)).
+pub fn transient_padded_dofs(dofs: usize) -> Option<usize> {
+    if dofs <= super::MAX_SIM_DOFS {
+        return None;
+    }
+    TRANSIENT_PADDED_DOFS.iter().copied().find(|&p| p >= dofs)
 }
 
 impl Sparse {
@@ -178,6 +203,42 @@ macro_rules! with_padded_size {
             Some(128) => {
                 let p = l.padded_to(128);
                 let $m = &Fixed::<256>(&p);
+                $body
+            }
+            _ => $fallback,
+        }
+    }};
+}
+
+/// Run `$body` with `$m` bound to `&Fixed<N>` of the lumped model `$l`
+/// padded to the next of [`TRANSIENT_PADDED_DOFS`] (models of more than
+/// [`MAX_SIM_DOFS`](super::MAX_SIM_DOFS) and at most
+/// [`MAX_TRANSIENT_DOFS`](super::MAX_TRANSIENT_DOFS) dofs; transient runs
+/// only, see the module docs), or evaluate `$fallback`.
+#[macro_export]
+macro_rules! with_transient_padded_size {
+    ($l:expr, $m:ident => $body:expr, else => $fallback:expr) => {{
+        use $crate::model::lumped::{transient_padded_dofs, Fixed};
+        let l: &$crate::Lumped = $l;
+        match transient_padded_dofs(l.dof_count()) {
+            Some(192) => {
+                let p = l.padded_to(192);
+                let $m = &Fixed::<384>(&p);
+                $body
+            }
+            Some(256) => {
+                let p = l.padded_to(256);
+                let $m = &Fixed::<512>(&p);
+                $body
+            }
+            Some(384) => {
+                let p = l.padded_to(384);
+                let $m = &Fixed::<768>(&p);
+                $body
+            }
+            Some(512) => {
+                let p = l.padded_to(512);
+                let $m = &Fixed::<1024>(&p);
                 $body
             }
             _ => $fallback,
