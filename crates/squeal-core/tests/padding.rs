@@ -4,7 +4,7 @@
 
 use squeal_core::model::lumped::{
     disc_pad_spec, padded_dofs, padded_solver, transient_padded_dofs, LumpedSpec, SpringSpec,
-    MAX_EXACT_DOFS, MAX_SIM_DOFS, MAX_TRANSIENT_DOFS,
+    MAX_EXACT_DOFS, MAX_SIM_DOFS, MAX_TRANSIENT_DOFS, PADDED_DOFS, TRANSIENT_PADDED_DOFS,
 };
 use squeal_core::sink::{EventLog, Recorder};
 // `padded_solver` only moves per-state tolerances; these runs have none.
@@ -51,6 +51,32 @@ fn padded_sizes_cover_every_model_up_to_the_limit() {
     assert_eq!(transient_padded_dofs(129), Some(192));
     assert_eq!(transient_padded_dofs(187), Some(192));
     assert_eq!(transient_padded_dofs(512), Some(512));
+}
+
+/// The state count a model is dispatched at.
+fn states<M: squeal_core::System<N>, const N: usize>(_: &M) -> usize {
+    N
+}
+
+/// Every padded size is compiled in: a model of exactly that many dofs is
+/// dispatched to it (not to the refusal), by its own macro only.
+#[test]
+fn every_padded_size_is_dispatched() {
+    let lp = disc_pad_at_n_2000();
+    for d in PADDED_DOFS {
+        let p = lp.padded_to(d);
+        let n = squeal_core::with_padded_size!(&p, m => states(m), else => 0);
+        assert_eq!(n, 2 * d, "{d} dofs");
+        let t = squeal_core::with_transient_padded_size!(&p, m => states(m), else => 0);
+        assert_eq!(t, 0, "{d} dofs: not a transient-only size");
+    }
+    for d in TRANSIENT_PADDED_DOFS {
+        let p = lp.padded_to(d);
+        let n = squeal_core::with_transient_padded_size!(&p, m => states(m), else => 0);
+        assert_eq!(n, 2 * d, "{d} dofs");
+        let c = squeal_core::with_padded_size!(&p, m => states(m), else => 0);
+        assert_eq!(c, 0, "{d} dofs: above the cycle sizes");
+    }
 }
 
 /// The disc–pad padded from 4 to the largest transient size (512 dofs,

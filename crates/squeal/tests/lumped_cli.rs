@@ -375,6 +375,21 @@ fn rms(h: &[String], r: &[Vec<f64>], name: &str) -> f64 {
     (r.iter().map(|row| row[c] * row[c]).sum::<f64>() / r.len() as f64).sqrt()
 }
 
+/// `simulate` of `file` (in `dir`, into `out`) and of the 4-dof disc–pad
+/// file (into `b4`) for `duration` seconds, CSV series, no plots: the big
+/// run's human summary.
+fn simulate_beside_disc_pad(dir: &Path, file: &str, out: &str, duration: &str) -> String {
+    let args = ["--duration", duration, "--no-plots", "--format", "csv"];
+    let mut a = vec!["simulate", file, "--out", out];
+    a.extend(args);
+    let human = ok(&squeal(dir, &a));
+    let small = scenarios().join("disc-pad.toml");
+    let mut a = vec!["simulate", small.to_str().unwrap(), "--out", "b4"];
+    a.extend(args);
+    ok(&squeal(dir, &a));
+    human
+}
+
 /// The disc–pad scenario file with a separate chain of `links` masses
 /// (`c1`…, 0.5 kg on 1e6 N/m springs), `c1` starting displaced by 1 mm; and
 /// the chain's dof names.
@@ -429,14 +444,7 @@ fn a_20_dof_file_simulates_and_maps() {
     let d = tempfile::tempdir().unwrap();
     let (text, chain) = disc_pad_with_chain(16);
     std::fs::write(d.path().join("big20.toml"), &text).unwrap();
-    let args = ["--duration", "0.1", "--no-plots", "--format", "csv"];
-    let mut a = vec!["simulate", "big20.toml", "--out", "b20"];
-    a.extend(args);
-    ok(&squeal(d.path(), &a));
-    let small = scenarios().join("disc-pad.toml");
-    let mut a = vec!["simulate", small.to_str().unwrap(), "--out", "b4"];
-    a.extend(args);
-    ok(&squeal(d.path(), &a));
+    simulate_beside_disc_pad(d.path(), "big20.toml", "b20", "0.1");
     let (h20, r20) = read_series(&d.path().join("b20"));
     let (h4, r4) = read_series(&d.path().join("b4"));
     let mut want = vec!["t".to_string()];
@@ -502,10 +510,7 @@ fn a_150_dof_file_simulates_in_a_transient_size_and_cycles_are_refused() {
     let d = tempfile::tempdir().unwrap();
     let (text, chain) = disc_pad_with_chain(146);
     std::fs::write(d.path().join("big150.toml"), &text).unwrap();
-    let args = ["--duration", "0.05", "--no-plots", "--format", "csv"];
-    let mut a = vec!["simulate", "big150.toml", "--out", "b150"];
-    a.extend(args);
-    let human = ok(&squeal(d.path(), &a));
+    let human = simulate_beside_disc_pad(d.path(), "big150.toml", "b150", "0.05");
     // 150 velocities: the summary lists the 12 largest, summary.json all.
     assert!(
         human.contains("RMS velocity over the last 20 % (m/s), the largest: ")
@@ -516,10 +521,6 @@ fn a_150_dof_file_simulates_in_a_transient_size_and_cycles_are_refused() {
         serde_json::from_str(&std::fs::read_to_string(d.path().join("b150/summary.json")).unwrap())
             .unwrap();
     assert_eq!(summary["rms"].as_object().unwrap().len(), 150);
-    let small = scenarios().join("disc-pad.toml");
-    let mut a = vec!["simulate", small.to_str().unwrap(), "--out", "b4"];
-    a.extend(args);
-    ok(&squeal(d.path(), &a));
     let (hb, rb) = read_series(&d.path().join("b150"));
     let (h4, r4) = read_series(&d.path().join("b4"));
     // t, 150 positions, 150 velocities, the contact's four columns.

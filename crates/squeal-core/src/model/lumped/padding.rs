@@ -165,49 +165,37 @@ impl Lumped {
     }
 }
 
+/// The padded-size dispatch behind [`with_padded_size!`](crate::with_padded_size)
+/// and [`with_transient_padded_size!`](crate::with_transient_padded_size):
+/// `$choose(dofs)` picks one of the listed `(dofs, states)` sizes.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __with_padding {
+    ($l:expr, $choose:path, [$(($dofs:literal, $states:literal)),+], $m:ident => $body:expr, else => $fallback:expr) => {{
+        use $crate::model::lumped::Fixed;
+        let l: &$crate::Lumped = $l;
+        match $choose(l.dof_count()) {
+            $(Some($dofs) => {
+                let p = l.padded_to($dofs);
+                let $m = &Fixed::<$states>(&p);
+                $body
+            })+
+            _ => $fallback,
+        }
+    }};
+}
+
 /// Run `$body` with `$m` bound to `&Fixed<N>` of the lumped model `$l`
 /// padded to the next of [`PADDED_DOFS`] (models of more than
 /// [`MAX_EXACT_DOFS`] and at most [`MAX_SIM_DOFS`](super::MAX_SIM_DOFS) dofs;
 /// simulation only, see the module docs), or evaluate `$fallback`.
 #[macro_export]
 macro_rules! with_padded_size {
-    ($l:expr, $m:ident => $body:expr, else => $fallback:expr) => {{
-        use $crate::model::lumped::{padded_dofs, Fixed};
-        let l: &$crate::Lumped = $l;
-        match padded_dofs(l.dof_count()) {
-            Some(24) => {
-                let p = l.padded_to(24);
-                let $m = &Fixed::<48>(&p);
-                $body
-            }
-            Some(32) => {
-                let p = l.padded_to(32);
-                let $m = &Fixed::<64>(&p);
-                $body
-            }
-            Some(48) => {
-                let p = l.padded_to(48);
-                let $m = &Fixed::<96>(&p);
-                $body
-            }
-            Some(64) => {
-                let p = l.padded_to(64);
-                let $m = &Fixed::<128>(&p);
-                $body
-            }
-            Some(96) => {
-                let p = l.padded_to(96);
-                let $m = &Fixed::<192>(&p);
-                $body
-            }
-            Some(128) => {
-                let p = l.padded_to(128);
-                let $m = &Fixed::<256>(&p);
-                $body
-            }
-            _ => $fallback,
-        }
-    }};
+    ($l:expr, $m:ident => $body:expr, else => $fallback:expr) => {
+        $crate::__with_padding!($l, $crate::model::lumped::padded_dofs,
+            [(24, 48), (32, 64), (48, 96), (64, 128), (96, 192), (128, 256)],
+            $m => $body, else => $fallback)
+    };
 }
 
 /// Run `$body` with `$m` bound to `&Fixed<N>` of the lumped model `$l`
@@ -217,31 +205,9 @@ macro_rules! with_padded_size {
 /// only, see the module docs), or evaluate `$fallback`.
 #[macro_export]
 macro_rules! with_transient_padded_size {
-    ($l:expr, $m:ident => $body:expr, else => $fallback:expr) => {{
-        use $crate::model::lumped::{transient_padded_dofs, Fixed};
-        let l: &$crate::Lumped = $l;
-        match transient_padded_dofs(l.dof_count()) {
-            Some(192) => {
-                let p = l.padded_to(192);
-                let $m = &Fixed::<384>(&p);
-                $body
-            }
-            Some(256) => {
-                let p = l.padded_to(256);
-                let $m = &Fixed::<512>(&p);
-                $body
-            }
-            Some(384) => {
-                let p = l.padded_to(384);
-                let $m = &Fixed::<768>(&p);
-                $body
-            }
-            Some(512) => {
-                let p = l.padded_to(512);
-                let $m = &Fixed::<1024>(&p);
-                $body
-            }
-            _ => $fallback,
-        }
-    }};
+    ($l:expr, $m:ident => $body:expr, else => $fallback:expr) => {
+        $crate::__with_padding!($l, $crate::model::lumped::transient_padded_dofs,
+            [(192, 384), (256, 512), (384, 768), (512, 1024)],
+            $m => $body, else => $fallback)
+    };
 }
