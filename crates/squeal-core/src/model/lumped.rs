@@ -193,6 +193,28 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     }
 }
 
+/// `Σ a_i·b_i` in four interleaved partial sums (term `i` into sum
+/// `i mod 4`, then `(s0 + s1) + (s2 + s3)`, then the tail in order): the
+/// sums are independent, so the compiler keeps them in one SIMD register
+/// instead of a chain of dependent additions (a dense `M⁻¹` row of a
+/// reduced FE model: hundreds of terms). The same order for every call;
+/// zero terms add exact zeros, so every padded size (a multiple of 4, the
+/// real entries leading each row) gives the same bits.
+#[inline(always)]
+fn dot_lanes(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut s = [0.0; 4];
+    let (ac, bc) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ar, br) = (ac.remainder(), bc.remainder());
+    for (x, y) in ac.zip(bc) {
+        for k in 0..4 {
+            s[k] += x[k] * y[k];
+        }
+    }
+    dot_from((s[0] + s[1]) + (s[2] + s[3]), ar, br)
+}
+
 /// `s + Σ a_i·b_i`, added in index order.
 #[inline(always)]
 fn dot_from(mut s: f64, a: &[f64], b: &[f64]) -> f64 {
@@ -290,8 +312,7 @@ impl Lumped {
             InvMass::Dense(inv) => {
                 let n = x.len();
                 for r in 0..n {
-                    let row = &inv[r * n..(r + 1) * n];
-                    out[r] = row.iter().zip(x).map(|(a, b)| a * b).sum();
+                    out[r] = dot_lanes(&inv[r * n..(r + 1) * n], x);
                 }
             }
             InvMass::Factored(f) => {
