@@ -187,7 +187,8 @@ fn linear_point(
 /// Outcome of one transient run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outcome {
-    /// decays, grows, stick-slip, steady, out-of-range, or failed.
+    /// decays, grows, stick-slip, steady, out-of-range, failed, or
+    /// too-short (see [`CLASSES`]).
     pub class: &'static str,
     /// RMS of the tangential velocity over the last window (m/s).
     pub rms: f64,
@@ -213,8 +214,9 @@ impl Outcome {
 }
 
 /// Watches the tangential velocities in windows and stops the run once its
-/// class is certain: decayed by 60 dB from its peak, or stick-slip/reversals
-/// with a steady amplitude (±2 % over three windows).
+/// class is certain: decayed by 60 dB from its peak in a run that moved
+/// (some position beyond [`Watch::still`] from its start), or
+/// stick-slip/reversals with a steady amplitude (±2 % over three windows).
 struct Watch {
     idx: Vec<usize>,
     v_idx: usize,
@@ -228,6 +230,16 @@ struct Watch {
     events_in_window: usize,
     event_windows: Vec<usize>,
     peak: f64,
+    /// Integration noise (m): [`STILL_TOLERANCES`] times the integrator's
+    /// relative tolerance times the largest position at the start (its
+    /// static deflection), or times its absolute position tolerance where
+    /// that is larger. A run whose positions never move further than this
+    /// from their start did not move.
+    still: f64,
+    /// Every position at the start.
+    q0: Vec<f64>,
+    /// The largest change of any position from its start so far (m).
+    motion: f64,
     decided: Option<&'static str>,
     /// The scenario's validity bound (m): a position beyond it ends the run `out-of-range`.
     validity: f64,
@@ -249,6 +261,12 @@ impl<const N: usize> Sink<N> for Watch {
             self.decided = Some("out-of-range");
             return Flow::Stop;
         }
+        let moved = z[..N / 2]
+            .iter()
+            .zip(&self.q0)
+            .map(|(q, q0)| (q - q0).abs())
+            .fold(0.0, f64::max);
+        self.motion = self.motion.max(moved);
         let a = self.idx.iter().map(|&i| z[i].abs()).fold(0.0, f64::max);
         self.cur_max = self.cur_max.max(a);
         self.sum2 += z[self.v_idx] * z[self.v_idx];
@@ -280,7 +298,10 @@ impl<const N: usize> Sink<N> for Watch {
                 self.decided = Some("stick-slip");
                 return Flow::Stop;
             }
-            if amp < 1e-3 * self.peak && recent.windows(2).all(|w| w[1] <= w[0]) {
+            if self.motion > self.still
+                && amp < 1e-3 * self.peak
+                && recent.windows(2).all(|w| w[1] <= w[0])
+            {
                 self.decided = Some("decays");
                 return Flow::Stop;
             }
@@ -348,6 +369,9 @@ fn watch_for<M: System<N>, const N: usize>(
         events_in_window: 0,
         event_windows: Vec::new(),
         peak: 0.0,
+        still: still_of(&z0, sc),
+        q0: z0[..N / 2].to_vec(),
+        motion: 0.0,
         decided: None,
         validity: sc.validity,
         surfaces,
@@ -355,6 +379,27 @@ fn watch_for<M: System<N>, const N: usize>(
         last: Vec::with_capacity(room),
     };
     Ok((w, z0))
+}
+
+/// How many of the integrator's tolerances a position must move from its
+/// start for a transient map to call it motion (see [`Watch::still`]).
+///
+/// DOP853 holds each step's local error to `atol + rtol·|q|`; at a start at
+/// equilibrium with no offset the positions wander by about that from
+/// their static deflection (the reduced FE disc's 140 kHz contact mode
+/// rings at 3·10⁻¹² m around 4·10⁻⁵ m with rtol 1e-8: 10 of them), and
+/// velocities of such a stiff mode reach µm/s, so a velocity threshold
+/// cannot tell noise from motion. A hundred tolerances can.
+pub const STILL_TOLERANCES: f64 = 100.0;
+
+/// [`Watch::still`] of a run of `sc` from `z0`.
+fn still_of<const N: usize>(z0: &[f64; N], sc: &Scenario) -> f64 {
+    let deflection = z0[..N / 2].iter().fold(0.0, |m: f64, q| m.max(q.abs()));
+    let atol = sc
+        .solver
+        .atol_pos
+        .unwrap_or(squeal_core::integrate::DEFAULT_ATOL_POS);
+    STILL_TOLERANCES * (sc.solver.rtol * deflection).max(atol)
 }
 
 /// The A-weighted level of the last complete window of `w`'s surfaces
@@ -389,6 +434,12 @@ fn classify(
 ) -> Result<Outcome, String> {
     let info = info.map_err(|e| e.to_string())?;
     let class = w.decided.unwrap_or_else(|| {
+        // From a start at round-off (an FE brake at its equilibrium, no
+        // offset) a growing mode can stay under the fast modes' decaying
+        // transient for the whole run: a trend of noise tells nothing.
+        if w.motion <= w.still {
+            return "too-short";
+        }
         let n = w.amps.len();
         if n < 6 {
             return "steady";
@@ -585,9 +636,9 @@ pub fn transient_at(sc: &Scenario, x: &Axis, y: &Axis, k: usize) -> Outcome {
 
 /// Do the linear verdict (σ) and the simulated outcome tell the same story?
 /// `yes` or `no`; `n/a` where there is no linear verdict (no steady sliding)
-/// or no outcome (the run failed). Never empty.
+/// or no outcome (the run failed, or was too short to tell). Never empty.
 pub fn agree(sigma: f64, o: &Outcome) -> &'static str {
-    if !sigma.is_finite() || o.class == "failed" {
+    if !sigma.is_finite() || matches!(o.class, "failed" | "too-short") {
         return "n/a";
     }
     let unstable = sigma > 0.0;
@@ -602,11 +653,17 @@ pub fn agree(sigma: f64, o: &Outcome) -> &'static str {
 }
 
 /// The outcome classes of a transient map, in legend order.
-pub const CLASSES: [&str; 6] = [
+///
+/// `too-short`: no position moved further from its start than integration
+/// noise ([`STILL_TOLERANCES`] tolerances of the integrator) in the whole
+/// run: from a start at round-off, the run cannot tell growth from decay
+/// (give the scenario an offset, or a longer duration).
+pub const CLASSES: [&str; 7] = [
     "decays",
     "grows",
     "stick-slip",
     "steady",
     "out-of-range",
     "failed",
+    "too-short",
 ];

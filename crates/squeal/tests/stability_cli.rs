@@ -160,6 +160,7 @@ fn transient_map_classifies_by_simulation() {
         "steady",
         "out-of-range",
         "failed",
+        "too-short",
     ] {
         assert!(svg.contains(class), "legend lacks {class}");
     }

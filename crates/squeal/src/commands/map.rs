@@ -32,7 +32,7 @@ pub struct MapArgs {
     /// Output folder (default: out/SCENARIO-map).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Classify every point by simulation too (decays / grows / stick-slip / steady / out-of-range).
+    /// Classify every point by simulation too (decays / grows / stick-slip / steady / out-of-range / too-short).
     #[arg(long)]
     pub transient: bool,
     /// Simulated time per point for --transient (default: the scenario's).
@@ -48,13 +48,33 @@ pub struct MapArgs {
     pub shard: Option<String>,
 }
 
+/// What a transient map's summary counts.
+#[derive(Debug, Clone, Copy)]
+pub struct Transient {
+    /// Points whose linear verdict and simulated outcome disagree.
+    pub disagree: usize,
+    /// Points whose run never moved beyond integration noise (`too-short`).
+    pub too_short: usize,
+}
+
+impl Transient {
+    /// The counts of a transient map whose outcomes are `trans`, `disagree`
+    /// of them disagreeing with the linear verdict.
+    pub fn of(disagree: usize, trans: &[squeal_study::map::Outcome]) -> Self {
+        Transient {
+            disagree,
+            too_short: trans.iter().filter(|o| o.class == "too-short").count(),
+        }
+    }
+}
+
 /// The summary `map` and `merge` print (or `--json`).
 pub fn report(
     labels: &Labels,
     x: &Axis,
     y: &Axis,
     lin: &[(f64, f64)],
-    disagree: Option<usize>,
+    transient: Option<Transient>,
     dest: &std::path::Path,
     json: bool,
 ) -> Result<(), RunError> {
@@ -64,7 +84,8 @@ pub fn report(
     if json {
         let doc = json!({
             "x": x.name, "y": y.name, "points": n, "unstable": unstable, "no_steady_sliding": nan,
-            "linear_nonlinear_disagree": disagree, "out": dest,
+            "linear_nonlinear_disagree": transient.map(|t| t.disagree),
+            "too_short": transient.map(|t| t.too_short), "out": dest,
         });
         crate::outln!(
             "{}",
@@ -78,13 +99,22 @@ pub fn report(
         x.values.len(),
         y.values.len()
     );
-    if let Some(d) = disagree {
-        crate::outln!("linear verdict and simulated outcome disagree at {d} points (see map.csv)");
+    if let Some(t) = transient {
+        crate::outln!(
+            "linear verdict and simulated outcome disagree at {} points (see map.csv)",
+            t.disagree
+        );
+        if t.too_short > 0 {
+            crate::outln!(
+                "{} points too-short: their runs never moved beyond integration noise (a start at round-off); give the scenario an offset or a longer --duration",
+                t.too_short
+            );
+        }
     }
     crate::outln!(
         "output: {} (map.csv, map.png{})",
         dest.display(),
-        match disagree {
+        match transient {
             Some(_) if dest.join("spl_dba.png").exists() => ", transient.png, spl_dba.png",
             Some(_) => ", transient.png",
             None => "",
@@ -132,7 +162,9 @@ pub fn run(a: MapArgs) -> Result<(), RunError> {
             &study.x,
             &study.y,
             &r.lin,
-            disagree,
+            disagree
+                .zip(r.trans.as_deref())
+                .map(|(d, t)| Transient::of(d, t)),
             &dest,
             a.json,
         );

@@ -2,7 +2,7 @@
 //! `reproduce` gathered into the unsharded study's files
 //! ([`squeal_files::merge`]), and its summary printed.
 
-use crate::commands::map::report;
+use crate::commands::map::{report, Transient};
 use crate::commands::reproduce::print_summary;
 use crate::run::{RunError, NEVER};
 use clap::Args;
@@ -36,7 +36,7 @@ pub fn run(a: MergeArgs) -> Result<(), RunError> {
             lin,
             disagree,
             failed,
-            ..
+            trans,
         } => {
             if !a.json {
                 crate::outln!(
@@ -50,7 +50,10 @@ pub fn run(a: MergeArgs) -> Result<(), RunError> {
                     }
                 );
             }
-            report(labels, x, y, lin, *disagree, dest, a.json)
+            let transient = disagree
+                .zip(trans.as_deref())
+                .map(|(d, t)| Transient::of(d, t));
+            report(labels, x, y, lin, transient, dest, a.json)
         }
         Merged::Sweep {
             name, param, sweep, ..
