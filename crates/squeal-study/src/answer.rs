@@ -339,8 +339,25 @@ impl Answer {
             answer.growth.as_ref(),
             linear_to_end,
         );
+        // Steady sliding is stable and no position left its start by more
+        // than the integration's noise: whatever steady line the judge saw
+        // (a stiff contact mode turns the noise into µm/s) is not a squeal.
+        let noise = answer.linear.as_ref().is_some_and(|l| !l.grows())
+            && an.judgement.verdict != RunVerdict::Decays
+            && !crate::analysis::moved_beyond_noise(run);
+        if noise {
+            answer.verdict = Some((
+                RunVerdict::Decays,
+                format!(
+                    "nothing moves: steady sliding is stable and no position leaves its start by more than {:e} of the largest (integration noise; judged {})",
+                    crate::analysis::STILL_POSITION,
+                    an.judgement.verdict
+                ),
+            ));
+        }
         let verdict = answer.verdict(an);
-        answer.squeal = squeal_answer(run, an, verdict, answer.linear.as_ref(), linear_to_end);
+        answer.squeal = squeal_answer(run, an, verdict, answer.linear.as_ref(), linear_to_end)
+            .filter(|_| !noise);
         // A steady run whose steady line is not the unstable mode's: the
         // run ended before the squeal showed.
         if let Some(s) = answer

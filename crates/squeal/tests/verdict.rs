@@ -382,3 +382,35 @@ fn tiny_signals_get_readable_axes() {
     );
     assert!(svg.contains("frequency (kHz)"));
 }
+
+/// The reduced FE disc (`examples/fe-brake/disc-reduced`) started at its
+/// equilibrium with no offset: its positions wander from their static
+/// deflection by integration noise alone, which its 140 kHz contact mode
+/// turns into µm/s. Linearly stable (μ = 0.1) the run decays, "nothing
+/// moves", with no squeal (before, the noise's steady 139.9 kHz line was a
+/// `limit-cycle` that squealed at −186 dB re 1 m/s); unstable (μ = 0.45),
+/// its mode (σ = +33 1/s) has not yet risen above the noise in 0.05 s: too
+/// short, with the linear prediction as the answer.
+#[test]
+fn an_fe_model_at_round_off_does_not_squeal_its_noise() {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/fe-brake/disc-reduced/scenario.toml");
+    let run = |mu: &str| {
+        summary(&[
+            p.to_str().unwrap(),
+            "--duration",
+            "0.05",
+            "--set",
+            "sample_rate=3e5",
+            "--set",
+            mu,
+        ])
+    };
+    let s = run("mu=0.1");
+    assert_eq!(verdict(&s), "decays", "{}", s["verdict_detail"]);
+    assert!(s["squeal"].is_null(), "{}", s["squeal"]);
+    let s = run("mu=0.45");
+    assert_eq!(verdict(&s), "too-short", "{}", s["verdict_detail"]);
+    assert_eq!(s["squeal"]["source"], "linear", "{}", s["squeal"]);
+    assert!((s["squeal"]["frequency_hz"].as_f64().unwrap() - 697.605).abs() < 0.01);
+}
