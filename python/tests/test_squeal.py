@@ -55,7 +55,11 @@ def test_run_shapes_dtypes_and_columns():
     assert np.shares_memory(run["vx_p"], run.data)  # a view, no copy
     assert run.events["t"].dtype == np.float64
     assert run.events["kind"].shape == run.events["contact"].shape == run.events["t"].shape
-    assert run.summary["verdict"] in ("squeal", "quiet", "steady", "decaying") or isinstance(run.summary["verdict"], str)
+    # One of the judge's words (README, "The verdict: one word per run").
+    assert run.summary["verdict"] in (
+        "out-of-range", "lift-off", "grows", "limit-cycle", "stick-slip",
+        "decays", "too-short", "neutral",
+    ), run.summary["verdict"]
     f, p = run.spectra["vx_p"]
     assert f.shape == p.shape and f.dtype == p.dtype == np.float64
     with pytest.raises(KeyError, match="nope"):
