@@ -382,12 +382,14 @@ fn watch_for<M: System<N>, const N: usize>(
 }
 
 /// How many of the integrator's tolerances a position must move from its
-/// start for a transient map to call it motion (see [`Watch::still`]).
+/// start for a transient map to call it motion: `STILL_TOLERANCES ·
+/// max(rtol · max_i |q_i(0)|, atol_pos)`.
 ///
 /// DOP853 holds each step's local error to `atol + rtol·|q|`; at a start at
-/// equilibrium with no offset the positions wander by about that from
-/// their static deflection (the reduced FE disc's 140 kHz contact mode
-/// rings at 3·10⁻¹² m around 4·10⁻⁵ m with rtol 1e-8: 10 of them), and
+/// equilibrium with no offset the positions wander by a few of those
+/// from their static deflection (the reduced FE disc of
+/// `examples/fe-brake/disc-reduced`: 3–5·10⁻¹² m in 0.05 s around
+/// 2.6·10⁻⁵ m with rtol 1e-8, 1.2·10⁻¹¹ m in 1 s), and
 /// velocities of such a stiff mode reach µm/s, so a velocity threshold
 /// cannot tell noise from motion. A hundred tolerances can.
 pub const STILL_TOLERANCES: f64 = 100.0;

@@ -10,6 +10,11 @@ fn brake() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/fe-brake/two-pad/brake.toml")
 }
 
+/// `examples/fe-brake/disc-reduced`: an FE disc of 2164 dofs reduced to 18.
+fn disc_reduced() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/fe-brake/disc-reduced/scenario.toml")
+}
+
 /// The unstable eigenvalue (largest real part) of `stability --json`.
 fn unstable(v: &serde_json::Value) -> (f64, f64) {
     eigenvalues(v)
@@ -294,8 +299,7 @@ fn the_reduced_brake_maps_listens_and_cycles() {
 #[test]
 fn a_reduced_fe_disc_of_18_dofs_cycles() {
     let d = tempfile::tempdir().unwrap();
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/fe-brake/disc-reduced/scenario.toml");
+    let p = disc_reduced();
     let p = p.to_str().unwrap();
     let s = json(&squeal(
         d.path(),
@@ -342,8 +346,7 @@ fn a_reduced_fe_disc_of_18_dofs_cycles() {
 #[test]
 fn a_transient_map_from_round_off_says_too_short() {
     let d = tempfile::tempdir().unwrap();
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples/fe-brake/disc-reduced/scenario.toml");
+    let p = disc_reduced();
     let p = p.to_str().unwrap();
     let map = |out: &str, extra: &[&str]| {
         let mut args = vec![

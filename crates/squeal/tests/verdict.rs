@@ -409,6 +409,28 @@ fn an_fe_model_at_round_off_does_not_squeal_its_noise() {
     let s = run("mu=0.1");
     assert_eq!(verdict(&s), "decays", "{}", s["verdict_detail"]);
     assert!(s["squeal"].is_null(), "{}", s["squeal"]);
+    // Nor does the terminal count the noise's cycles as the squeal's.
+    let d = tempfile::tempdir().unwrap();
+    let out = squeal(
+        d.path(),
+        &[
+            "simulate",
+            p.to_str().unwrap(),
+            "--duration",
+            "0.05",
+            "--set",
+            "sample_rate=3e5",
+            "--set",
+            "mu=0.1",
+            "--no-plots",
+        ],
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.starts_with("does not squeal: verdict decays"),
+        "{text}"
+    );
+    assert!(!text.contains("per cycle of the squeal"), "{text}");
     let s = run("mu=0.45");
     assert_eq!(verdict(&s), "too-short", "{}", s["verdict_detail"]);
     assert_eq!(s["squeal"]["source"], "linear", "{}", s["squeal"]);

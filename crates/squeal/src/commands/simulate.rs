@@ -259,7 +259,11 @@ fn print_human(sc: &Scenario, run: &run::Run, summary: &serde_json::Value, dest:
         summary["verdict"].as_str().unwrap_or("?"),
         summary["verdict_detail"]["reason"].as_str().unwrap_or("")
     );
-    if let Some(c) = summary["verdict_detail"]["per_cycle"].as_object() {
+    // Per cycle of a line the run shows (not of noise, nor of a prediction).
+    if let Some(c) = summary["verdict_detail"]["per_cycle"]
+        .as_object()
+        .filter(|_| summary["squeal"]["source"] == "run")
+    {
         let g = |k: &str| c.get(k).and_then(|v| v.as_f64()).unwrap_or(f64::NAN);
         crate::outln!(
             "per cycle of the squeal ({:.0} cycles in the judged window): {:.3} true sticks, {:.3} slip reversals, {:.3} separations",
