@@ -21,31 +21,43 @@ use squeal_signal::{
 /// an equilibrium, not motion to classify.
 pub const STILL: f64 = 1e-8;
 
-/// A run none of whose positions leaves its first sample by more than this
-/// fraction of the largest first sample (its static deflection) has not
-/// moved beyond integration noise: a hundred relative tolerances of 1e-8.
-/// Started at equilibrium, DOP853's local errors (`rtol·|q|` a step) wander
-/// the positions by a few tolerances (the reduced FE disc of
+/// How many of the integrator's tolerances a position must move from its
+/// start to count as motion ([`position_noise`]).
+///
+/// DOP853 holds each step's local error to `atol + rtol·|q|`; started at
+/// equilibrium with no offset, the positions wander by a few of those from
+/// their static deflection (the reduced FE disc of
 /// `examples/fe-brake/disc-reduced`: 3–5·10⁻¹² m in 0.05 s around
-/// 2.6·10⁻⁵ m), and a stiff contact mode turns that into µm/s, above
-/// [`STILL`].
-pub const STILL_POSITION: f64 = 1e-6;
+/// 2.6·10⁻⁵ m with rtol 1e-8, 1.2·10⁻¹¹ m in 1 s), and a stiff contact
+/// mode turns that into µm/s, above [`STILL`]: a velocity threshold cannot
+/// tell noise from motion. A hundred tolerances can.
+pub const STILL_TOLERANCES: f64 = 100.0;
+
+/// The integration noise of positions starting at most `deflection` (m)
+/// from 0 under `solver`: `STILL_TOLERANCES · max(rtol · deflection,
+/// atol_pos)`. A run none of whose positions leaves its start by more has
+/// not moved.
+pub fn position_noise(deflection: f64, solver: &squeal_core::SolverOptions) -> f64 {
+    let atol = solver
+        .atol_pos
+        .unwrap_or(squeal_core::integrate::DEFAULT_ATOL_POS);
+    STILL_TOLERANCES * (solver.rtol * deflection).max(atol)
+}
 
 /// Whether some position of `run` (every state coordinate with a velocity
-/// column) leaves its first sample by more than [`STILL_POSITION`] times the
-/// largest first sample; true when every position starts at 0.
-pub fn moved_beyond_noise(run: &Run) -> bool {
+/// column) leaves its first sample by more than [`position_noise`] under
+/// `solver`.
+pub fn moved_beyond_noise(run: &Run, solver: &squeal_core::SolverOptions) -> bool {
     let positions: Vec<&[f64]> = state_pairs(run)
         .iter()
         .filter_map(|(p, _)| run.column(p))
         .collect();
     let q0 = |c: &[f64]| c.first().copied().unwrap_or(0.0);
-    let bound = STILL_POSITION * positions.iter().fold(0.0f64, |m, c| m.max(q0(c).abs()));
-    bound.is_nan()
-        || bound <= 0.0
-        || positions
-            .iter()
-            .any(|c| c.iter().any(|q| (q - q0(c)).abs() > bound))
+    let deflection = positions.iter().fold(0.0f64, |m, c| m.max(q0(c).abs()));
+    let bound = position_noise(deflection, solver);
+    positions
+        .iter()
+        .any(|c| c.iter().any(|q| q.is_nan() || (q - q0(c)).abs() > bound))
 }
 
 /// Longest Welch segment (samples): 16384 at 200 kHz resolves 12.2 Hz.

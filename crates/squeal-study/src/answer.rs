@@ -344,13 +344,13 @@ impl Answer {
         // (a stiff contact mode turns the noise into µm/s) is not a squeal.
         let noise = answer.linear.as_ref().is_some_and(|l| !l.grows())
             && an.judgement.verdict != RunVerdict::Decays
-            && !crate::analysis::moved_beyond_noise(run);
+            && !crate::analysis::moved_beyond_noise(run, &sc.solver);
         if noise {
             answer.verdict = Some((
                 RunVerdict::Decays,
                 format!(
-                    "nothing moves: steady sliding is stable and no position leaves its start by more than {:e} of the largest (integration noise; judged {})",
-                    crate::analysis::STILL_POSITION,
+                    "nothing moves: steady sliding is stable and no position leaves its start by more than {} tolerances of the integrator (integration noise; judged {})",
+                    crate::analysis::STILL_TOLERANCES,
                     an.judgement.verdict
                 ),
             ));

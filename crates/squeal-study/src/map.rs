@@ -8,6 +8,7 @@
 //! one row per point in the order given; a point's result does not depend
 //! on which others are computed with it, so shards merge bit for bit.
 
+use crate::analysis::position_noise;
 use crate::critical::growth_at;
 use crate::error::{Cancel, Progress, StudyError};
 use crate::model::AnyModel;
@@ -230,16 +231,13 @@ struct Watch {
     events_in_window: usize,
     event_windows: Vec<usize>,
     peak: f64,
-    /// Integration noise (m): [`STILL_TOLERANCES`] times the integrator's
-    /// relative tolerance times the largest position at the start (its
-    /// static deflection), or times its absolute position tolerance where
-    /// that is larger. A run whose positions never move further than this
-    /// from their start did not move.
+    /// Integration noise (m) of the positions ([`position_noise`] of the
+    /// largest at the start).
     still: f64,
     /// Every position at the start.
     q0: Vec<f64>,
-    /// The largest change of any position from its start so far (m).
-    motion: f64,
+    /// Whether some position has moved further than `still` from its start.
+    moved: bool,
     decided: Option<&'static str>,
     /// The scenario's validity bound (m): a position beyond it ends the run `out-of-range`.
     validity: f64,
@@ -261,12 +259,12 @@ impl<const N: usize> Sink<N> for Watch {
             self.decided = Some("out-of-range");
             return Flow::Stop;
         }
-        let moved = z[..N / 2]
-            .iter()
-            .zip(&self.q0)
-            .map(|(q, q0)| (q - q0).abs())
-            .fold(0.0, f64::max);
-        self.motion = self.motion.max(moved);
+        if !self.moved {
+            self.moved = z[..N / 2]
+                .iter()
+                .zip(&self.q0)
+                .any(|(q, q0)| (q - q0).abs() > self.still);
+        }
         let a = self.idx.iter().map(|&i| z[i].abs()).fold(0.0, f64::max);
         self.cur_max = self.cur_max.max(a);
         self.sum2 += z[self.v_idx] * z[self.v_idx];
@@ -298,10 +296,7 @@ impl<const N: usize> Sink<N> for Watch {
                 self.decided = Some("stick-slip");
                 return Flow::Stop;
             }
-            if self.motion > self.still
-                && amp < 1e-3 * self.peak
-                && recent.windows(2).all(|w| w[1] <= w[0])
-            {
+            if self.moved && amp < 1e-3 * self.peak && recent.windows(2).all(|w| w[1] <= w[0]) {
                 self.decided = Some("decays");
                 return Flow::Stop;
             }
@@ -369,9 +364,12 @@ fn watch_for<M: System<N>, const N: usize>(
         events_in_window: 0,
         event_windows: Vec::new(),
         peak: 0.0,
-        still: still_of(&z0, sc),
+        still: position_noise(
+            z0[..N / 2].iter().fold(0.0, |m: f64, q| m.max(q.abs())),
+            &sc.solver,
+        ),
         q0: z0[..N / 2].to_vec(),
-        motion: 0.0,
+        moved: false,
         decided: None,
         validity: sc.validity,
         surfaces,
@@ -379,29 +377,6 @@ fn watch_for<M: System<N>, const N: usize>(
         last: Vec::with_capacity(room),
     };
     Ok((w, z0))
-}
-
-/// How many of the integrator's tolerances a position must move from its
-/// start for a transient map to call it motion: `STILL_TOLERANCES ·
-/// max(rtol · max_i |q_i(0)|, atol_pos)`.
-///
-/// DOP853 holds each step's local error to `atol + rtol·|q|`; at a start at
-/// equilibrium with no offset the positions wander by a few of those
-/// from their static deflection (the reduced FE disc of
-/// `examples/fe-brake/disc-reduced`: 3–5·10⁻¹² m in 0.05 s around
-/// 2.6·10⁻⁵ m with rtol 1e-8, 1.2·10⁻¹¹ m in 1 s), and
-/// velocities of such a stiff mode reach µm/s, so a velocity threshold
-/// cannot tell noise from motion. A hundred tolerances can.
-pub const STILL_TOLERANCES: f64 = 100.0;
-
-/// [`Watch::still`] of a run of `sc` from `z0`.
-fn still_of<const N: usize>(z0: &[f64; N], sc: &Scenario) -> f64 {
-    let deflection = z0[..N / 2].iter().fold(0.0, |m: f64, q| m.max(q.abs()));
-    let atol = sc
-        .solver
-        .atol_pos
-        .unwrap_or(squeal_core::integrate::DEFAULT_ATOL_POS);
-    STILL_TOLERANCES * (sc.solver.rtol * deflection).max(atol)
 }
 
 /// The A-weighted level of the last complete window of `w`'s surfaces
@@ -439,7 +414,7 @@ fn classify(
         // From a start at round-off (an FE brake at its equilibrium, no
         // offset) a growing mode can stay under the fast modes' decaying
         // transient for the whole run: a trend of noise tells nothing.
-        if w.motion <= w.still {
+        if !w.moved {
             return "too-short";
         }
         let n = w.amps.len();
@@ -657,7 +632,8 @@ pub fn agree(sigma: f64, o: &Outcome) -> &'static str {
 /// The outcome classes of a transient map, in legend order.
 ///
 /// `too-short`: no position moved further from its start than integration
-/// noise ([`STILL_TOLERANCES`] tolerances of the integrator) in the whole
+/// noise ([`STILL_TOLERANCES`](crate::analysis::STILL_TOLERANCES)
+/// tolerances of the integrator, [`position_noise`]) in the whole
 /// run: from a start at round-off, the run cannot tell growth from decay
 /// (give the scenario an offset, or a longer duration).
 pub const CLASSES: [&str; 7] = [

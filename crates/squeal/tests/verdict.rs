@@ -395,17 +395,19 @@ fn tiny_signals_get_readable_axes() {
 fn an_fe_model_at_round_off_does_not_squeal_its_noise() {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../examples/fe-brake/disc-reduced/scenario.toml");
-    let run = |mu: &str| {
-        summary(&[
-            p.to_str().unwrap(),
+    let p = p.to_str().unwrap();
+    let args = |mu| {
+        vec![
+            p,
             "--duration",
             "0.05",
             "--set",
             "sample_rate=3e5",
             "--set",
             mu,
-        ])
+        ]
     };
+    let run = |mu| summary(&args(mu));
     let s = run("mu=0.1");
     assert_eq!(verdict(&s), "decays", "{}", s["verdict_detail"]);
     assert!(s["squeal"].is_null(), "{}", s["squeal"]);
@@ -413,17 +415,7 @@ fn an_fe_model_at_round_off_does_not_squeal_its_noise() {
     let d = tempfile::tempdir().unwrap();
     let out = squeal(
         d.path(),
-        &[
-            "simulate",
-            p.to_str().unwrap(),
-            "--duration",
-            "0.05",
-            "--set",
-            "sample_rate=3e5",
-            "--set",
-            "mu=0.1",
-            "--no-plots",
-        ],
+        &[&["simulate"], &args("mu=0.1")[..], &["--no-plots"]].concat(),
     );
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
